@@ -1,0 +1,75 @@
+#include "app/Outputs.h"
+
+#include <fstream>
+#include <stdexcept>
+
+namespace rend {
+
+void writeFileAtomic(const std::filesystem::path& path, const std::string& text) {
+    std::filesystem::path tmp = path;
+    tmp += ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    }
+    std::filesystem::rename(tmp, path);
+}
+
+StatsWriter::StatsWriter(const std::filesystem::path& path) : path_(path) {
+    std::filesystem::path partial = path_;
+    partial += ".partial";
+    file_ = std::fopen(partial.c_str(), "w");
+    if (!file_) throw std::runtime_error("cannot write " + partial.string());
+    std::fputs("frame,time,kinetic_energy,strain_energy,max_speed,broken_bonds\n", file_);
+}
+
+StatsWriter::~StatsWriter() {
+    if (file_) std::fclose(file_);
+}
+
+void StatsWriter::append(const Row& r) {
+    std::fprintf(file_, "%d,%.9g,%.9g,%.9g,%.9g,%zu\n", r.frame, r.time, r.kineticEnergy,
+                 r.strainEnergy, r.maxSpeed, r.brokenBonds);
+    std::fflush(file_);
+}
+
+void StatsWriter::finish() {
+    if (!file_) return;
+    std::fclose(file_);
+    file_ = nullptr;
+    std::filesystem::path partial = path_;
+    partial += ".partial";
+    std::filesystem::rename(partial, path_);
+}
+
+std::string jsonString(const std::string& text) {
+    std::string out = "\"";
+    for (char c : text) {
+        switch (c) {
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\t':
+                out += "\\t";
+                break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20) {
+                    char buf[8];
+                    std::snprintf(buf, sizeof buf, "\\u%04x", c);
+                    out += buf;
+                } else {
+                    out += c;
+                }
+        }
+    }
+    return out + "\"";
+}
+
+}  // namespace rend

@@ -1,0 +1,58 @@
+#pragma once
+// `rend run` and `rend check`: scene -> Membrane -> FrameView -> surface -> renderer -> PNG,
+// plus stats.csv and run.json. Stages run only when an output needs them.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "app/Scene.h"
+#include "sim/Membrane.h"
+
+namespace rend {
+
+struct RunOptions {
+    std::filesystem::path outDir = "out";
+    std::optional<std::pair<int, int>> frames;  ///< inclusive range of frames to write
+    std::optional<RendererKind> renderer;       ///< overrides the scene's [render] renderer
+    bool progressBar = false;                   ///< redraw one line; else one line per frame
+};
+
+/// Wall seconds per stage of a run.
+struct StageTimes {
+    double setup = 0.0;
+    double simulate = 0.0;
+    double surface = 0.0;
+    double render = 0.0;
+    double write = 0.0;
+};
+
+struct RunSummary {
+    int particles = 0;
+    std::size_t bonds = 0;
+    double dt = 0.0;
+    double stableDt = 0.0;
+    int substeps = 0;  ///< explicit steps per frame
+    long steps = 0;
+    int framesSimulated = 0;
+    int framesWritten = 0;
+    StageTimes seconds;
+    double nsPerParticleStep = 0.0;
+};
+
+/// Builds the membrane and checks what only a built membrane can tell (dt against the stable
+/// bound, boundary regions that claim no particle). Throws SceneError. Writes nothing.
+sim::Membrane prepareMembrane(const Scene& scene);
+
+/// Steps per frame and the dt that lands frames exactly on k / fps, never above `dt`.
+std::pair<int, double> substepsPerFrame(double dt, double fps);
+
+/// Runs the scene into options.outDir. Throws SceneError before anything is written, and
+/// sim::NumericalBlowUp after finishing stats.csv and run.json up to the failing frame.
+RunSummary runScene(const Scene& scene, const RunOptions& options);
+
+/// Parses "7" or "1-120" against the scene's frame count. Throws SceneError.
+std::pair<int, int> parseFrameRange(const std::string& text, int frameCount);
+
+}  // namespace rend

@@ -1,0 +1,28 @@
+#pragma once
+// Bond families in CSR form, each bond stored from both ends so a force loop over particle i
+// writes only to i (LAMMPS PERI style): no atomics, identical bits for any thread count.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace rend::sim {
+
+struct BondFamilies {
+    std::vector<int> offsets;         ///< bonds of particle i: [offsets[i], offsets[i+1])
+    std::vector<int> partners;        ///< j
+    std::vector<double> restLength;   ///< |x0_j - x0_i|
+    std::vector<double> weight;       ///< W0 = 1 - |r0|/R, eq. 23
+    std::vector<std::uint8_t> alive;  ///< 1 intact, 0 broken
+
+    int particleCount() const { return int(offsets.size()) - 1; }
+    std::size_t directedCount() const { return partners.size(); }
+    std::size_t bondCount() const { return partners.size() / 2; }
+    int familySize(int i) const { return offsets[i + 1] - offsets[i]; }
+};
+
+/// Every pair closer than `horizon` in the rest configuration, partners sorted by index.
+BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double horizon);
+
+}  // namespace rend::sim

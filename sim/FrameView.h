@@ -1,0 +1,44 @@
+#pragma once
+// The only thing that crosses from sim/ to render/: read-only views of one frame's state.
+// Like OpenVDB's ParticleList contract (tools/ParticlesToLevelSet.h), it is small and
+// documented; render/ never sees the solver.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+namespace rend::sim {
+
+struct FrameView {
+    int frame = 0;      ///< frame index, 1-based as in frame_0001.png
+    double time = 0.0;  ///< simulated seconds
+
+    std::span<const Eigen::Vector3d> positions;      ///< current x_i
+    std::span<const Eigen::Vector3d> velocities;     ///< current v_i
+    std::span<const Eigen::Vector3d> restPositions;  ///< x0_i (the rest lattice)
+    std::span<const double> theta;   ///< diffusive quantity; empty when the scene has none
+    std::span<const double> damage;  ///< per-particle damage in [0,1]; empty if nothing breaks
+
+    /// Rest-lattice triangles (particle indices, counter-clockwise seen from +z at rest).
+    std::span<const std::array<int, 3>> restTriangles;
+
+    /// Bond families in CSR form: bonds of particle i are [bondOffsets[i], bondOffsets[i+1]).
+    /// Every bond is stored from both ends.
+    std::span<const int> bondOffsets;
+    std::span<const int> bondPartners;
+    std::span<const double> bondRestLength;
+    std::span<const std::uint8_t> bondAlive;  ///< 1 intact, 0 broken
+
+    std::size_t particleCount() const { return positions.size(); }
+
+    /// Index of the bond i->j in the CSR arrays, or -1 when i and j are not bonded.
+    int findBond(int i, int j) const {
+        for (int b = bondOffsets[i]; b < bondOffsets[i + 1]; ++b)
+            if (bondPartners[b] == j) return b;
+        return -1;
+    }
+};
+
+}  // namespace rend::sim

@@ -1,0 +1,241 @@
+#include "sim/Membrane.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace rend::sim {
+namespace {
+
+// splitmix64 (Steele, Lea & Flood 2014): a per-particle hash, so the perturbation of a
+// particle does not depend on how many particles came before it or on the thread count.
+double uniformFromHash(std::uint64_t seed, std::uint64_t index) {
+    std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (index + 1);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return double(z >> 11) * 0x1.0p-53;
+}
+
+}  // namespace
+
+Membrane::Membrane(const MembraneParams& params)
+    : params_(params), lattice_(generateLattice(params.sheet)) {
+    const SheetParams& sheet = params.sheet;
+    horizon_ = sheet.horizonFactor * sheet.dx;
+    x0_ = lattice_.positions;
+    const int n = int(x0_.size());
+    if (n < 2) throw std::invalid_argument("the sheet holds fewer than two particles");
+    volume_.assign(n, lattice_.particleArea * sheet.thickness);
+    mass_.assign(n, params.material.density * lattice_.particleArea * sheet.thickness);
+    bonds_ = buildBondFamilies(x0_, horizon_);
+    computeBondScales(params);
+    assignBoundaries();
+    x_ = x0_;
+    perturb(sheet.perturbationAmplitude, sheet.perturbationSeed);
+    v_.assign(n, Eigen::Vector3d::Zero());
+    force_.assign(n, Eigen::Vector3d::Zero());
+    dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
+}
+
+void Membrane::computeBondScales(const MembraneParams& params) {
+    const int n = particleCount();
+    const bool paper = params.material.micromodulus == MicromodulusMode::Paper;
+    bondScale_.resize(bonds_.directedCount());
+    double interiorWeightedVolume = 0.0;
+    for (int i = 0; i < n; ++i) {
+        double weightedVolume = 0.0;
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            const double w = bonds_.weight[b];
+            weightedVolume += w * volume_[j];
+            // Literal eq. 22 multiplies by the area A_j; the consistent form by V_i V_j.
+            const double measure = paper ? lattice_.particleArea : volume_[i] * volume_[j];
+            bondScale_[b] = w * measure / bonds_.restLength[b];
+        }
+        interiorWeightedVolume = std::max(interiorWeightedVolume, weightedVolume);
+    }
+    if (interiorWeightedVolume <= 0.0)
+        throw std::invalid_argument(
+            "no particle has a bond with non-zero weight: raise the horizon");
+    const MaterialParams& m = params.material;
+    law_.c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
+                   : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
+
+    double worstRatio = 0.0;  // max_i sum_j k_ij / m_i
+    for (int i = 0; i < n; ++i) {
+        double stiffness = 0.0;
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            stiffness += bondScale_[b] * law_.stiffness() / bonds_.restLength[b];
+        worstRatio = std::max(worstRatio, stiffness / mass_[i]);
+    }
+    stableDt_ = std::sqrt(2.0 / worstRatio);
+    // A runaway particle moves far faster than the fastest wave (~dx * omega_max), anything the
+    // boundaries impose, or free fall over the whole run.
+    double boundarySpeed = 0.0;
+    for (const auto& bc : params.boundaries)
+        boundarySpeed = std::max(boundarySpeed, bc.velocity.norm());
+    const double waveSpeed = params.sheet.dx * std::sqrt(worstRatio);
+    speedLimit_ = 100.0 * waveSpeed + 10.0 * boundarySpeed +
+                  2.0 * params.gravity.norm() * params.time.duration + 1e-6;
+}
+
+void Membrane::assignBoundaries() {
+    constraint_.assign(x0_.size(), kFree);
+    for (int k = 0; k < int(params_.boundaries.size()); ++k) {
+        const BoundaryCondition& bc = params_.boundaries[k];
+        const std::int16_t tag = bc.kind == BoundaryKind::Pinned ? kPinned : std::int16_t(k);
+        for (int i = 0; i < particleCount(); ++i)
+            if (bc.region.contains(x0_[i])) constraint_[i] = tag;
+    }
+}
+
+std::vector<int> Membrane::boundaryParticleCounts() const {
+    std::vector<int> counts(params_.boundaries.size(), 0);
+    for (int k = 0; k < int(params_.boundaries.size()); ++k)
+        for (int i = 0; i < particleCount(); ++i)
+            if (params_.boundaries[k].region.contains(x0_[i])) ++counts[k];
+    return counts;
+}
+
+void Membrane::perturb(double amplitude, std::uint64_t seed) {
+    if (amplitude <= 0.0) return;
+    for (int i = 0; i < particleCount(); ++i)
+        x_[i].z() += amplitude * (2.0 * uniformFromHash(seed, std::uint64_t(i)) - 1.0);
+}
+
+void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
+    const int n = particleCount();
+    force.resize(n);
+    const auto& offsets = bonds_.offsets;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        const Eigen::Vector3d xi = x_[i];
+        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
+            if (!bonds_.alive[b]) continue;
+            const Eigen::Vector3d r = x_[bonds_.partners[b]] - xi;
+            const double length = r.norm();
+            const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+            sum += (bondScale_[b] * law_.force(eta) / length) * r;
+        }
+        force[i] = sum;
+    }
+}
+
+Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
+    const BoundaryCondition& bc = params_.boundaries[k];
+    const double ramp = bc.rampTime > 0.0 ? std::min(1.0, t / bc.rampTime) : 1.0;
+    return ramp * bc.velocity;
+}
+
+bool Membrane::isBad(int i) const {
+    // Written so that NaN compares false and counts as bad.
+    return !(v_[i].squaredNorm() <= speedLimit_ * speedLimit_) || !x_[i].allFinite();
+}
+
+void Membrane::integrate() {
+    const int n = particleCount();
+    const double dt = dt_;
+    const double tNext = time_ + dt;
+    const Eigen::Vector3d gravity = params_.gravity;
+    const double damping = params_.damping;
+    bool bad = false;
+#pragma omp parallel for schedule(static) reduction(|| : bad)
+    for (int i = 0; i < n; ++i) {
+        const std::int16_t c = constraint_[i];
+        if (c == kFree)
+            v_[i] += dt * (force_[i] / mass_[i] + gravity - damping * v_[i]);
+        else if (c == kPinned)
+            v_[i].setZero();
+        else
+            v_[i] = boundaryVelocity(c, tNext);
+        x_[i] += dt * v_[i];
+        bad = bad || isBad(i);
+    }
+    time_ = tNext;
+    ++steps_;
+    if (bad) reportBlowUp();
+}
+
+void Membrane::step() {
+    computeForces(force_);
+    integrate();
+}
+
+void Membrane::reportBlowUp() const {
+    int culprit = 0;
+    while (culprit < particleCount() && !isBad(culprit)) ++culprit;
+    const double suggested = 0.5 * std::min(dt_, stableDt_);
+    std::ostringstream out;
+    out << "numerical blow-up at step " << steps_ << " (t = " << time_ << " s): particle "
+        << culprit << " (rest position " << x0_[culprit].x() << ", " << x0_[culprit].y()
+        << ") has speed " << v_[culprit].norm() << " m/s, beyond the plausible limit "
+        << speedLimit_ << " m/s. The time step " << dt_ << " s against the stable limit "
+        << stableDt_ << " s is the usual cause; use dt <= " << suggested
+        << " (or dt = \"auto\"), or slow the boundary velocities.";
+    throw NumericalBlowUp(out.str(), steps_, culprit, suggested);
+}
+
+double Membrane::kineticEnergy() const {
+    double sum = 0.0;
+    for (int i = 0; i < particleCount(); ++i) sum += 0.5 * mass_[i] * v_[i].squaredNorm();
+    return sum;
+}
+
+double Membrane::strainEnergy() const {
+    double sum = 0.0;
+    for (int i = 0; i < particleCount(); ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            if (!bonds_.alive[b]) continue;
+            const double eta = (x_[bonds_.partners[b]] - x_[i]).norm() / bonds_.restLength[b] - 1.0;
+            // Each bond is stored from both ends: half of U_ij from each.
+            sum += 0.5 * bondScale_[b] * bonds_.restLength[b] * law_.energy(eta);
+        }
+    return sum;
+}
+
+double Membrane::maxSpeed() const {
+    double m = 0.0;
+    for (const auto& v : v_) m = std::max(m, v.norm());
+    return m;
+}
+
+std::size_t Membrane::brokenBondCount() const {
+    return std::size_t(std::count(bonds_.alive.begin(), bonds_.alive.end(), 0)) / 2;
+}
+
+Eigen::Vector3d Membrane::totalMomentum() const {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int i = 0; i < particleCount(); ++i) p += mass_[i] * v_[i];
+    return p;
+}
+
+Eigen::Matrix3d Membrane::particleStress(int i) const {
+    Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+    for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+        if (!bonds_.alive[b]) continue;
+        const Eigen::Vector3d r = x_[bonds_.partners[b]] - x_[i];
+        const double length = r.norm();
+        const double eta = length / bonds_.restLength[b] - 1.0;
+        sigma += (bondScale_[b] * law_.force(eta) / length) * r * r.transpose();
+    }
+    return sigma / (2.0 * volume_[i]);
+}
+
+FrameView Membrane::view(int frame) const {
+    FrameView v;
+    v.frame = frame;
+    v.time = time_;
+    v.positions = x_;
+    v.velocities = v_;
+    v.restPositions = x0_;
+    v.restTriangles = lattice_.triangles;
+    v.bondOffsets = bonds_.offsets;
+    v.bondPartners = bonds_.partners;
+    v.bondRestLength = bonds_.restLength;
+    v.bondAlive = bonds_.alive;
+    return v;
+}
+
+}  // namespace rend::sim

@@ -13,7 +13,7 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& text)
 /// stats.csv, one row per frame: appended to stats.csv.partial and flushed each frame, renamed
 /// to stats.csv when the run ends (normally or by a blow-up).
 class StatsWriter {
-  public:
+public:
     explicit StatsWriter(const std::filesystem::path& path);
     ~StatsWriter();
     StatsWriter(const StatsWriter&) = delete;
@@ -27,7 +27,7 @@ class StatsWriter {
     void append(const Row& row);
     void finish();
 
-  private:
+private:
     std::filesystem::path path_;
     std::FILE* file_ = nullptr;
 };

@@ -44,7 +44,7 @@ void checkBoundaries(const Scene& scene, const sim::Membrane& membrane) {
 }
 
 class Progress {
-  public:
+public:
     Progress(bool bar, int frames) : bar_(bar), frames_(frames), start_(Clock::now()) {}
 
     void frameDone(int frame, double time, const std::string& wrote) {
@@ -62,7 +62,7 @@ class Progress {
         if (frame == frames_) std::fputc('\n', stderr);
     }
 
-  private:
+private:
     bool bar_;
     int frames_;
     Clock::time_point start_;
@@ -70,7 +70,7 @@ class Progress {
 
 // Surface and renderer, created only when a frame is to be drawn.
 class FrameWriter {
-  public:
+public:
     FrameWriter(const Scene& scene, const std::filesystem::path& dir) : scene_(scene), dir_(dir) {}
 
     std::string write(const sim::FrameView& view, StageTimes& seconds) {
@@ -90,7 +90,7 @@ class FrameWriter {
         return (std::filesystem::path("frames") / name).string();
     }
 
-  private:
+private:
     const Scene& scene_;
     std::filesystem::path dir_;
     std::unique_ptr<render::LatticeSurface> surface_;

@@ -12,7 +12,7 @@
 namespace rend::render {
 
 class LatticeSurface {
-  public:
+public:
     /// Maps every rest triangle's edges to bond indices once. An edge that is not a bond
     /// (a square lattice with R < sqrt(2) dx has no diagonal bonds) never drops its triangle.
     explicit LatticeSurface(const sim::FrameView& rest);
@@ -24,7 +24,7 @@ class LatticeSurface {
     /// Indices into FrameView::restTriangles of the triangles kept in this frame.
     std::vector<int> keptTriangles(const sim::FrameView& frame) const;
 
-  private:
+private:
     std::vector<std::array<int, 3>> triangles_;
     std::vector<std::array<int, 3>> edgeBonds_;         ///< bond index per edge (i->j), -1 if none
     std::vector<std::array<int, 3>> edgeBondsReverse_;  ///< the same bonds stored as j->i

@@ -9,7 +9,7 @@ namespace {
 
 // Uniform hash grid with cells of the horizon's size: a family lies in the 3x3 block of cells.
 class CellGrid {
-  public:
+public:
     CellGrid(std::span<const Eigen::Vector3d> points, double cell) : cell_(cell) {
         for (int i = 0; i < int(points.size()); ++i) cells_[key(cellOf(points[i]))].push_back(i);
     }
@@ -24,7 +24,7 @@ class CellGrid {
             }
     }
 
-  private:
+private:
     Eigen::Vector2i cellOf(const Eigen::Vector3d& p) const {
         return {int(std::floor(p.x() / cell_)), int(std::floor(p.y() / cell_))};
     }

@@ -20,7 +20,7 @@ namespace rend::sim {
 /// The state stopped being finite, or a particle ran away faster than anything the material
 /// or the boundary conditions can produce.
 class NumericalBlowUp : public std::runtime_error {
-  public:
+public:
     NumericalBlowUp(const std::string& message, long step, int particle, double suggestedDt)
         : std::runtime_error(message), step(step), particle(particle), suggestedDt(suggestedDt) {}
     long step;
@@ -29,7 +29,7 @@ class NumericalBlowUp : public std::runtime_error {
 };
 
 class Membrane {
-  public:
+public:
     explicit Membrane(const MembraneParams& params);
 
     int particleCount() const { return int(x0_.size()); }
@@ -75,7 +75,7 @@ class Membrane {
     const BondFamilies& bonds() const { return bonds_; }
     const Lattice& lattice() const { return lattice_; }
 
-  private:
+private:
     static constexpr std::int16_t kFree = -1;
     static constexpr std::int16_t kPinned = -2;
 

@@ -1,8 +1,9 @@
 // Pipeline pieces that need no scene file: frame timing and the --frames option.
 
+#include "app/Pipeline.h"
+
 #include <gtest/gtest.h>
 
-#include "app/Pipeline.h"
 #include "app/SceneError.h"
 
 using namespace rend;

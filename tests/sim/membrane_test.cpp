@@ -1,5 +1,7 @@
 // Tests of the membrane core against closed-form answers (VALIDATION.md).
 
+#include "sim/Membrane.h"
+
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -7,8 +9,6 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-
-#include "sim/Membrane.h"
 
 using namespace rend::sim;
 
@@ -152,8 +152,8 @@ TEST(Bonds, ForceIsTheNegativeGradientOfStrainEnergy) {
 TEST(Membrane, MomentumIsConservedWithoutBoundaryConditions) {
     Membrane m(smallSheet(LatticeKind::Hexagonal, 0.4));
     for (int i = 0; i < m.particleCount(); ++i)
-        m.velocities()[i] = 0.05 * Eigen::Vector3d(std::sin(1.3 * i), std::cos(2.1 * i),
-                                                   std::sin(0.7 * i + 1.0));
+        m.velocities()[i] =
+            0.05 * Eigen::Vector3d(std::sin(1.3 * i), std::cos(2.1 * i), std::sin(0.7 * i + 1.0));
     const Eigen::Vector3d before = m.totalMomentum();
     double scale = 0.0;
     for (int i = 0; i < m.particleCount(); ++i) scale += m.masses()[i] * m.velocities()[i].norm();

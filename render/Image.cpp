@@ -1,0 +1,110 @@
+#include "render/Image.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+
+// stb is third-party C; its warnings under -Wextra -Wpedantic are not ours to fix.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+#pragma GCC diagnostic pop
+
+namespace rend::render {
+
+namespace {
+
+void checkShape(const Image& image) {
+    const auto expected = static_cast<std::size_t>(image.width) * image.height * 3;
+    if (image.width <= 0 || image.height <= 0 || image.rgb.size() != expected)
+        throw std::runtime_error("writePngAtomic: image size does not match its pixel buffer");
+}
+
+int channelDifference(const Image& a, const Image& b, std::size_t pixel) {
+    int worst = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+        const int d = std::abs(int(a.rgb[pixel * 3 + c]) - int(b.rgb[pixel * 3 + c]));
+        worst = std::max(worst, d);
+    }
+    return worst;
+}
+
+void markPixel(Image& diff, std::size_t pixel, bool failing) {
+    std::uint8_t* p = &diff.rgb[pixel * 3];
+    if (failing) {
+        p[0] = 255;
+        p[1] = 0;
+        p[2] = 0;
+        return;
+    }
+    // Darkening the passing pixels keeps the picture recognisable while red failures pop out.
+    for (int c = 0; c < 3; ++c) p[c] = static_cast<std::uint8_t>(p[c] * 3 / 10);
+}
+
+}  // namespace
+
+void writePngAtomic(const Image& image, const std::filesystem::path& path) {
+    checkShape(image);
+    std::filesystem::path tmp = path;
+    tmp += ".tmp";
+    const int ok = stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.rgb.data(),
+                                  image.width * 3);
+    if (!ok) {
+        std::error_code ignored;
+        std::filesystem::remove(tmp, ignored);
+        throw std::runtime_error("cannot write PNG " + tmp.string());
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw std::runtime_error("cannot move PNG into place at " + path.string());
+    }
+}
+
+Image readPng(const std::filesystem::path& path) {
+    int w = 0;
+    int h = 0;
+    int channels = 0;
+    std::uint8_t* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
+    if (!data) {
+        throw std::runtime_error("cannot read PNG " + path.string() + ": " + stbi_failure_reason());
+    }
+    Image image{w, h, std::vector<std::uint8_t>(data, data + std::size_t(w) * h * 3)};
+    stbi_image_free(data);
+    return image;
+}
+
+ImageDiff compareImages(const Image& reference, const Image& actual, int tolerance) {
+    ImageDiff result;
+    result.diff = reference;
+    if (reference.width != actual.width || reference.height != actual.height ||
+        reference.rgb.size() != actual.rgb.size()) {
+        return result;  // defaults already say "everything fails"
+    }
+    const std::size_t pixels = reference.rgb.size() / 3;
+    std::size_t failing = 0;
+    int worst = 0;
+    for (std::size_t i = 0; i < pixels; ++i) {
+        const int d = channelDifference(reference, actual, i);
+        worst = std::max(worst, d);
+        const bool fails = d > tolerance;
+        failing += fails ? 1 : 0;
+        markPixel(result.diff, i, fails);
+    }
+    result.failingFraction = pixels > 0 ? double(failing) / double(pixels) : 0.0;
+    result.maxDifference = worst;
+    return result;
+}
+
+}  // namespace rend::render

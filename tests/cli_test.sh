@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# End-to-end checks of the rend command: exit statuses, messages, and that bad input leaves
+# nothing behind. Usage: tests/cli_test.sh path/to/rend   (run from the repository root)
+set -uo pipefail
+rend=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0
+failed=0
+
+check() {  # check NAME CONDITION...
+    local name=$1
+    shift
+    if "$@"; then
+        passed=$((passed + 1))
+    else
+        failed=$((failed + 1))
+        echo "FAILED: $name"
+    fi
+}
+run() {  # run EXPECTED_STATUS args... ; leaves output in $tmp/stdout, $tmp/stderr
+    local expected=$1
+    shift
+    "$rend" "$@" >"$tmp/stdout" 2>"$tmp/stderr"
+    local status=$?
+    if [[ $status -ne $expected ]]; then
+        echo "rend $* exited $status, expected $expected"
+        cat "$tmp/stderr"
+        return 1
+    fi
+}
+no_partial_files() { ! find "$1" -name '*.tmp' -o -name '*.partial' | grep -q .; }
+
+# --version names every library actually in use.
+check "version" run 0 --version
+for lib in Eigen OpenMP Embree OpenVDB assimp OSMesa; do
+    check "version names $lib" grep -q "$lib" "$tmp/stdout"
+done
+
+check "check accepts the shipped scenes" run 0 check scenes/stretch.toml
+check "check accepts the shear scene" run 0 check scenes/shear.toml
+check "check prints particle count" grep -q "particles" "$tmp/stdout"
+
+# Every malformed scene: exit 2, a file:line:column message, and nothing written.
+for bad in tests/scenes/bad_*.toml; do
+    check "$bad is refused by check" run 2 check "$bad"
+    check "$bad message has file:line:column" grep -qE "$(basename "$bad"):[0-9]+:[0-9]+: error" "$tmp/stderr"
+    check "$bad is refused by run" run 2 run "$bad" --out "$tmp/bad_out"
+    check "$bad leaves no output folder" test ! -e "$tmp/bad_out"
+done
+
+# A dt above the Silling-Askari bound is refused before anything is written.
+check "unstable dt refused" run 2 run scenes/stretch.toml --set time.dt=0.01 --out "$tmp/unstable"
+check "unstable dt message" grep -q "stable limit" "$tmp/stderr"
+check "unstable dt from --set is located there" grep -qE "^--set 'time.dt=0.01': error: time.dt" "$tmp/stderr"
+check "unstable dt in a file" run 2 check tests/scenes/unstable_dt.toml
+check "unstable dt in a file has file:line:column" grep -qE "unstable_dt.toml:[0-9]+:[0-9]+: error: time.dt" "$tmp/stderr"
+check "unstable dt leaves no output" test ! -e "$tmp/unstable"
+check "bad --set refused" run 2 check scenes/stretch.toml --set material.E=-5
+check "bad --frames refused" run 2 run scenes/stretch.toml --frames 0-3 --out "$tmp/frames"
+check "bad --frames leaves no output" test ! -e "$tmp/frames"
+
+# Forcing an unstable dt trips the guard: exit 3, the step and the particle named, and the
+# outputs written so far are complete.
+small=(--set 'sheet.size=[0.4,0.4]' --set time.duration=0.25)
+check "blow-up exits 3" run 3 run scenes/stretch.toml "${small[@]}" --set time.dt=0.02 \
+    --set time.allow_unstable=true --renderer none --out "$tmp/blowup"
+check "blow-up names step and particle" grep -qE "step [0-9]+ .*particle [0-9]+" "$tmp/stderr"
+check "blow-up suggests a dt" grep -q "use dt <=" "$tmp/stderr"
+check "blow-up keeps complete stats" test -s "$tmp/blowup/stats.csv"
+check "blow-up run.json says so" grep -q '"status": "blow-up"' "$tmp/blowup/run.json"
+check "blow-up leaves no partial files" no_partial_files "$tmp/blowup"
+
+# A short run writes frames, stats.csv (one row per frame) and a valid run.json.
+check "short run" run 0 run scenes/stretch.toml "${small[@]}" --out "$tmp/ok" \
+    --set render.width=160 --set render.height=90
+check "six frames written" test "$(ls "$tmp/ok/frames" | grep -c '^frame_000[1-6].png$')" -eq 6
+check "stats has a row per frame" test "$(wc -l <"$tmp/ok/stats.csv")" -eq 7
+check "run.json is JSON" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['status']=='ok' and d['particles']>0 and d['ns_per_particle_step']>0" "$tmp/ok/run.json"
+check "short run leaves no partial files" no_partial_files "$tmp/ok"
+check "frames option" run 0 run scenes/stretch.toml "${small[@]}" --out "$tmp/range" \
+    --frames 5-6 --set render.width=32 --set render.height=32
+check "only frames 5-6 written" test "$(ls "$tmp/range/frames" | tr '\n' ' ')" = "frame_0005.png frame_0006.png "
+check "renderer none" run 0 run scenes/stretch.toml "${small[@]}" --renderer none --out "$tmp/none"
+check "renderer none writes no frames" test ! -e "$tmp/none/frames"
+
+echo "$passed passed, $failed failed"
+[[ $failed -eq 0 ]]

@@ -1,0 +1,475 @@
+// Tests for render/: lattice surface extraction, colouring, PNG I/O, image comparison, the
+// OSMesa preview renderer (against a reference image) and the library version report.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "render/ColorMap.h"
+#include "render/Image.h"
+#include "render/LatticeSurface.h"
+#include "render/OsmesaRenderer.h"
+#include "render/Versions.h"
+#include "sim/FrameView.h"
+
+namespace fs = std::filesystem;
+using rend::render::ColorBy;
+using rend::render::Image;
+using rend::render::LatticeSurface;
+using rend::render::RenderSettings;
+using rend::sim::FrameView;
+
+namespace {
+
+// A square particle grid in the z = 0 plane, centred on the origin, with every cell split
+// into two counter-clockwise triangles and bonds to all 8 neighbours (so every triangle edge,
+// diagonals included, is a bond). Built here rather than by the simulator's lattice
+// generator so these tests pin down render/ alone.
+struct Sheet {
+    int nx;
+    int ny;
+    double dx;
+    std::vector<Eigen::Vector3d> positions, velocities, rest;
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<int> offsets, partners;
+    std::vector<double> restLength;
+    std::vector<std::uint8_t> alive;
+
+    Sheet(int nx_, int ny_, double dx_) : nx(nx_), ny(ny_), dx(dx_) {
+        makeParticles();
+        makeTriangles();
+        makeBonds();
+    }
+
+    int id(int i, int j) const { return j * nx + i; }
+
+    FrameView view() const {
+        FrameView v;
+        v.frame = 1;
+        v.positions = positions;
+        v.velocities = velocities;
+        v.restPositions = rest;
+        v.restTriangles = triangles;
+        v.bondOffsets = offsets;
+        v.bondPartners = partners;
+        v.bondRestLength = restLength;
+        v.bondAlive = alive;
+        return v;
+    }
+
+    void breakBond(int a, int b) {
+        const FrameView v = view();
+        alive.at(v.findBond(a, b)) = 0;
+        alive.at(v.findBond(b, a)) = 0;
+    }
+
+private:
+    void makeParticles() {
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                rest.emplace_back((i - 0.5 * (nx - 1)) * dx, (j - 0.5 * (ny - 1)) * dx, 0.0);
+        positions = rest;
+        velocities.assign(rest.size(), Eigen::Vector3d::Zero());
+    }
+
+    void makeTriangles() {
+        for (int j = 0; j + 1 < ny; ++j) {
+            for (int i = 0; i + 1 < nx; ++i) {
+                triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+                triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+            }
+        }
+    }
+
+    void makeBonds() {
+        offsets.push_back(0);
+        for (int j = 0; j < ny; ++j) {
+            for (int i = 0; i < nx; ++i) {
+                addNeighbours(i, j);
+                offsets.push_back(static_cast<int>(partners.size()));
+            }
+        }
+        alive.assign(partners.size(), 1);
+    }
+
+    void addNeighbours(int i, int j) {
+        for (int dj = -1; dj <= 1; ++dj) {
+            for (int di = -1; di <= 1; ++di) {
+                const int ni = i + di;
+                const int nj = j + dj;
+                if ((di == 0 && dj == 0) || ni < 0 || nj < 0 || ni >= nx || nj >= ny) continue;
+                partners.push_back(id(ni, nj));
+                restLength.push_back((rest[id(ni, nj)] - rest[id(i, j)]).norm());
+            }
+        }
+    }
+};
+
+Image solidImage(int w, int h, std::uint8_t value) {
+    return Image{w, h, std::vector<std::uint8_t>(std::size_t(w) * h * 3, value)};
+}
+
+double luminance(const Eigen::Vector3f& c) {
+    return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
+}
+
+fs::path scratchDir() {
+    const fs::path dir = fs::path(::testing::TempDir()) / "rend_render_tests";
+    fs::create_directories(dir);
+    return dir;
+}
+
+}  // namespace
+
+// ---- LatticeSurface ------------------------------------------------------------------------
+
+TEST(LatticeSurface, KeepsEveryTriangleWhenAllBondsAreIntact) {
+    const Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    EXPECT_EQ(surface.keptTriangles(sheet.view()).size(), sheet.triangles.size());
+}
+
+TEST(LatticeSurface, BrokenInteriorBondDropsBothAdjacentTriangles) {
+    Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    // The horizontal edge (2,2)-(3,2) has one triangle of cell (2,1) below it and one of
+    // cell (2,2) above it.
+    sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
+    const auto kept = surface.keptTriangles(sheet.view());
+    EXPECT_EQ(kept.size(), sheet.triangles.size() - 2);
+    for (int t : kept) {
+        const std::set<int> corners(sheet.triangles[t].begin(), sheet.triangles[t].end());
+        EXPECT_FALSE(corners.count(sheet.id(2, 2)) && corners.count(sheet.id(3, 2)));
+    }
+}
+
+TEST(LatticeSurface, BrokenBoundaryBondDropsItsSingleTriangle) {
+    Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    sheet.breakBond(sheet.id(0, 0), sheet.id(1, 0));
+    EXPECT_EQ(surface.keptTriangles(sheet.view()).size(), sheet.triangles.size() - 1);
+}
+
+TEST(LatticeSurface, BondBrokenInOneDirectionOnlyStillDropsTheTriangles) {
+    Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    // Neighbouring triangles walk a shared edge in opposite directions, so marking only one
+    // CSR copy would otherwise cut just one of them.
+    const FrameView v = sheet.view();
+    sheet.alive.at(v.findBond(sheet.id(3, 3), sheet.id(2, 2))) = 0;
+    const auto kept = surface.keptTriangles(sheet.view());
+    // The diagonal (2,2)-(3,3) is shared by both triangles of cell (2,2).
+    EXPECT_EQ(kept.size(), sheet.triangles.size() - 2);
+}
+
+TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {
+    Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
+    const auto mesh = surface.build(sheet.view(), RenderSettings{});
+    EXPECT_EQ(mesh.triangles.size(), sheet.triangles.size() - 2);
+    EXPECT_EQ(mesh.positions.size(), mesh.normals.size());
+    EXPECT_EQ(mesh.positions.size(), mesh.colors.size());
+    for (const auto& t : mesh.triangles)
+        for (auto v : t) EXPECT_LT(v, mesh.positions.size());
+}
+
+TEST(LatticeSurface, NormalsOfAFlatSheetAtRestAreUnitAndPointUp) {
+    const Sheet sheet(6, 5, 0.5);
+    const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), RenderSettings{});
+    for (const auto& n : mesh.normals) {
+        EXPECT_NEAR(n.norm(), 1.0f, 1e-6f);
+        EXPECT_NEAR(n.z(), 1.0f, 1e-6f);
+    }
+}
+
+TEST(LatticeSurface, IsolatedVertexGetsTheUpNormal) {
+    Sheet sheet(3, 3, 1.0);
+    const LatticeSurface surface(sheet.view());
+    // Cutting every bond of the corner particle leaves it referenced by no triangle.
+    for (int b = sheet.offsets[0]; b < sheet.offsets[1]; ++b) sheet.breakBond(0, sheet.partners[b]);
+    sheet.positions[0].z() = 5.0;
+    const auto mesh = surface.build(sheet.view(), RenderSettings{});
+    EXPECT_TRUE(mesh.normals[0].isApprox(Eigen::Vector3f::UnitZ()));
+}
+
+// ---- Colour map ----------------------------------------------------------------------------
+
+TEST(ColorMap, RunsFromDarkBlueToBrightYellow) {
+    const Eigen::Vector3f low = rend::render::colormap(0.0);
+    const Eigen::Vector3f high = rend::render::colormap(1.0);
+    EXPECT_GT(low.z(), low.y());    // blue-ish start
+    EXPECT_GT(high.x(), high.z());  // yellow end: red and green well above blue
+    EXPECT_GT(high.y(), high.z());
+    EXPECT_LT(luminance(low), 0.05);
+    EXPECT_GT(luminance(high), 0.6);
+}
+
+TEST(ColorMap, BrightnessRisesMonotonically) {
+    double previous = -1.0;
+    for (int k = 0; k <= 64; ++k) {
+        const double l = luminance(rend::render::colormap(k / 64.0));
+        EXPECT_GT(l, previous) << "at t = " << k / 64.0;
+        previous = l;
+    }
+}
+
+TEST(ColorMap, ClampsOutOfRangeInputsToTheEndpoints) {
+    using rend::render::colormap;
+    EXPECT_TRUE(colormap(-3.0).isApprox(colormap(0.0)));
+    EXPECT_TRUE(colormap(7.0).isApprox(colormap(1.0)));
+    EXPECT_TRUE(colormap(std::nan("")).isApprox(colormap(0.0)));
+}
+
+TEST(ColorMap, StrainOfAUniformlyStretchedSheetIsTheStretch) {
+    Sheet sheet(6, 5, 1.0);
+    for (std::size_t i = 0; i < sheet.positions.size(); ++i)
+        sheet.positions[i] = 1.1 * sheet.rest[i];
+    const auto strain = rend::render::particleField(sheet.view(), ColorBy::Strain);
+    ASSERT_EQ(strain.size(), sheet.positions.size());
+    for (double s : strain) EXPECT_NEAR(s, 0.1, 1e-12);
+}
+
+TEST(ColorMap, StrainIgnoresBrokenBonds) {
+    Sheet sheet(3, 1, 1.0);
+    sheet.positions[2].x() += 1.0;  // stretch only the (1,2) bond, then break it
+    sheet.breakBond(1, 2);
+    const auto strain = rend::render::particleField(sheet.view(), ColorBy::Strain);
+    EXPECT_NEAR(strain[0], 0.0, 1e-12);
+    EXPECT_NEAR(strain[1], 0.0, 1e-12);
+    EXPECT_NEAR(strain[2], 0.0, 1e-12);  // no intact bonds left: no load
+}
+
+TEST(ColorMap, SpeedIsTheVelocityMagnitude) {
+    Sheet sheet(2, 2, 1.0);
+    sheet.velocities[3] = Eigen::Vector3d(3.0, 0.0, 4.0);
+    const auto speed = rend::render::particleField(sheet.view(), ColorBy::Speed);
+    EXPECT_DOUBLE_EQ(speed[0], 0.0);
+    EXPECT_DOUBLE_EQ(speed[3], 5.0);
+    EXPECT_TRUE(rend::render::particleField(sheet.view(), ColorBy::None).empty());
+}
+
+TEST(ColorMap, ColoursUseAlbedoWithoutAFieldAndTheFieldMaximumOtherwise) {
+    Sheet sheet(2, 2, 1.0);
+    sheet.velocities[3] = Eigen::Vector3d(0.0, 0.0, 2.0);
+    RenderSettings settings;
+    auto colors = rend::render::particleColors(sheet.view(), settings);
+    EXPECT_TRUE(colors[0].isApprox(settings.albedo.cast<float>()));
+    settings.colorBy = ColorBy::Speed;
+    colors = rend::render::particleColors(sheet.view(), settings);
+    EXPECT_TRUE(colors[0].isApprox(rend::render::colormap(0.0)));
+    EXPECT_TRUE(colors[3].isApprox(rend::render::colormap(1.0)));
+    settings.colorRange = std::array<double, 2>{0.0, 4.0};
+    colors = rend::render::particleColors(sheet.view(), settings);
+    EXPECT_TRUE(colors[3].isApprox(rend::render::colormap(0.5)));
+}
+
+TEST(ColorMap, AllZeroFieldMapsToTheLowEnd) {
+    const Sheet sheet(2, 2, 1.0);
+    RenderSettings settings;
+    settings.colorBy = ColorBy::Speed;
+    for (const auto& c : rend::render::particleColors(sheet.view(), settings))
+        EXPECT_TRUE(c.isApprox(rend::render::colormap(0.0)));
+}
+
+// ---- PNG I/O and comparison ----------------------------------------------------------------
+
+TEST(Image, PngRoundTripPreservesEveryPixel) {
+    Image image = solidImage(7, 5, 0);
+    for (std::size_t k = 0; k < image.rgb.size(); ++k) image.rgb[k] = std::uint8_t(k * 37 % 256);
+    const fs::path path = scratchDir() / "round_trip.png";
+    rend::render::writePngAtomic(image, path);
+    const Image back = rend::render::readPng(path);
+    EXPECT_EQ(back.width, image.width);
+    EXPECT_EQ(back.height, image.height);
+    EXPECT_EQ(back.rgb, image.rgb);
+}
+
+TEST(Image, AtomicWriteLeavesNoTemporaryFile) {
+    const fs::path path = scratchDir() / "atomic.png";
+    fs::remove(path);
+    rend::render::writePngAtomic(solidImage(4, 3, 128), path);
+    EXPECT_TRUE(fs::exists(path));
+    EXPECT_FALSE(fs::exists(fs::path(path.string() + ".tmp")));
+}
+
+TEST(Image, WritingIntoAMissingDirectoryThrows) {
+    const fs::path path = scratchDir() / "no" / "such" / "dir" / "x.png";
+    EXPECT_THROW(rend::render::writePngAtomic(solidImage(2, 2, 0), path), std::runtime_error);
+}
+
+TEST(Image, ReadingAMissingFileThrows) {
+    EXPECT_THROW(rend::render::readPng(scratchDir() / "missing.png"), std::runtime_error);
+}
+
+TEST(Image, IdenticalImagesHaveNoFailingPixels) {
+    const Image a = solidImage(8, 6, 90);
+    const auto diff = rend::render::compareImages(a, a, 0);
+    EXPECT_EQ(diff.failingFraction, 0.0);
+    EXPECT_EQ(diff.maxDifference, 0);
+}
+
+TEST(Image, OneChangedPixelFailsExactlyThatFraction) {
+    const Image a = solidImage(8, 6, 90);
+    Image b = a;
+    b.rgb[(2 * 8 + 3) * 3 + 1] = 200;
+    const auto diff = rend::render::compareImages(a, b, 8);
+    EXPECT_DOUBLE_EQ(diff.failingFraction, 1.0 / (8 * 6));
+    EXPECT_EQ(diff.maxDifference, 110);
+    const std::uint8_t* red = &diff.diff.rgb[(2 * 8 + 3) * 3];
+    EXPECT_EQ(red[0], 255);
+    EXPECT_EQ(red[1], 0);
+    EXPECT_EQ(diff.diff.rgb[0], 27);  // passing pixels darkened to 30 %
+}
+
+TEST(Image, DifferencesWithinToleranceDoNotFail) {
+    const Image a = solidImage(4, 4, 100);
+    const Image b = solidImage(4, 4, 108);
+    EXPECT_EQ(rend::render::compareImages(a, b, 8).failingFraction, 0.0);
+    EXPECT_EQ(rend::render::compareImages(a, b, 7).failingFraction, 1.0);
+}
+
+TEST(Image, SizeMismatchFailsEverything) {
+    const auto diff = rend::render::compareImages(solidImage(4, 4, 0), solidImage(4, 5, 0), 8);
+    EXPECT_EQ(diff.failingFraction, 1.0);
+}
+
+// ---- OSMesa renderer -----------------------------------------------------------------------
+
+namespace {
+
+// A 2.3 x 1.5 sheet with a gentle standing wave along x; the stretched flanks of the wave
+// light up in the strain colouring.
+Sheet wavySheet() {
+    Sheet sheet(24, 16, 0.1);
+    for (auto& p : sheet.positions) p.z() = 0.15 * std::sin(2.0 * std::numbers::pi * p.x() / 1.2);
+    return sheet;
+}
+
+RenderSettings smallSettings() {
+    RenderSettings settings;
+    settings.width = 160;
+    settings.height = 90;
+    settings.supersample = 2;
+    settings.colorBy = ColorBy::Strain;
+    settings.colorRange = std::array<double, 2>{0.0, 0.14};
+    // Low enough that the horizon, where the ground fades into the background, is in frame.
+    settings.camera.position = Eigen::Vector3d(0.6, -3.0, 1.0);
+    settings.camera.lookAt = Eigen::Vector3d(0.0, 0.0, -0.1);
+    return settings;
+}
+
+Image renderWavySheet(const RenderSettings& settings) {
+    const Sheet sheet = wavySheet();
+    const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), settings);
+    rend::render::OsmesaRenderer renderer;
+    return renderer.render(mesh, settings);
+}
+
+const std::uint8_t* pixel(const Image& image, int x, int y) {
+    return &image.rgb[(std::size_t(y) * image.width + x) * 3];
+}
+
+int pixelDistance(const std::uint8_t* a, const std::uint8_t* b) {
+    int d = 0;
+    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[c]) - int(b[c])));
+    return d;
+}
+
+}  // namespace
+
+TEST(OsmesaRenderer, ProducesAnImageOfTheRequestedSize) {
+    const Image image = renderWavySheet(smallSettings());
+    EXPECT_EQ(image.width, 160);
+    EXPECT_EQ(image.height, 90);
+    EXPECT_EQ(image.rgb.size(), 160u * 90u * 3u);
+}
+
+TEST(OsmesaRenderer, DrawsTheSheetOverTheBackground) {
+    RenderSettings settings = smallSettings();
+    settings.ground = false;
+    const Image image = renderWavySheet(settings);
+    const std::uint8_t* corner = pixel(image, 0, 0);
+    // The camera looks at the sheet's centre, so the centre pixel must be sheet, not sky.
+    EXPECT_GT(pixelDistance(pixel(image, 80, 45), corner), 30);
+    int covered = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            covered += pixelDistance(pixel(image, x, y), corner) > 8;
+    EXPECT_GT(covered, image.width * image.height / 10);
+}
+
+TEST(OsmesaRenderer, EmptyMeshWithoutGroundIsPureBackground) {
+    RenderSettings settings = smallSettings();
+    settings.ground = false;
+    rend::render::OsmesaRenderer renderer;
+    const Image image = renderer.render(rend::render::Mesh{}, settings);
+    for (int y = 0; y < image.height; y += 7)
+        for (int x = 0; x < image.width; x += 7)
+            ASSERT_EQ(pixelDistance(pixel(image, x, y), pixel(image, 0, 0)), 0);
+}
+
+TEST(OsmesaRenderer, SameInputGivesIdenticalPixelsAndResizesBetweenCalls) {
+    const Sheet sheet = wavySheet();
+    RenderSettings settings = smallSettings();
+    const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), settings);
+    rend::render::OsmesaRenderer renderer;
+    const Image first = renderer.render(mesh, settings);
+    settings.width = 64;
+    settings.height = 48;
+    EXPECT_EQ(renderer.render(mesh, settings).width, 64);
+    settings = smallSettings();
+    EXPECT_EQ(renderer.render(mesh, settings).rgb, first.rgb);
+}
+
+TEST(OsmesaRenderer, MatchesTheReferenceImage) {
+    const fs::path reference = fs::path(REND_SOURCE_DIR) / "tests/data/osmesa_sheet.png";
+    const Image actual = renderWavySheet(smallSettings());
+    const char* regenerate = std::getenv("REND_REGENERATE_REFERENCES");
+    if (regenerate && std::string(regenerate) == "1") {
+        rend::render::writePngAtomic(actual, reference);
+        std::cout << "[ regenerated ] " << reference << "\n";
+        return;
+    }
+    ASSERT_TRUE(fs::exists(reference))
+        << reference << " is missing; run with REND_REGENERATE_REFERENCES=1 to create it";
+    const auto diff = rend::render::compareImages(rend::render::readPng(reference), actual, 8);
+    if (diff.failingFraction > 0.01) {
+        const fs::path actualPath = scratchDir() / "osmesa_sheet_actual.png";
+        const fs::path diffPath = scratchDir() / "osmesa_sheet_diff.png";
+        rend::render::writePngAtomic(actual, actualPath);
+        rend::render::writePngAtomic(diff.diff, diffPath);
+        ADD_FAILURE() << "rendered image differs from " << reference << ": "
+                      << diff.failingFraction * 100 << "% of pixels off by more than 8 (max "
+                      << diff.maxDifference << ")\n  actual: " << actualPath
+                      << "\n  diff:   " << diffPath;
+    }
+}
+
+// ---- Versions ------------------------------------------------------------------------------
+
+TEST(Versions, ReportsEveryRenderingLibrary) {
+    const auto versions = rend::render::renderLibraryVersions();
+    auto find = [&](const std::string& name) {
+        for (const auto& [lib, version] : versions)
+            if (lib == name) return version;
+        return std::string();
+    };
+    for (const char* lib : {"Embree", "OpenVDB", "assimp", "OSMesa", "stb"}) {
+        EXPECT_FALSE(find(lib).empty()) << lib;
+        std::cout << "  " << lib << ": " << find(lib) << "\n";
+    }
+    EXPECT_NE(find("Embree").find('.'), std::string::npos);
+    const std::string gl = find("OSMesa");
+    EXPECT_TRUE(gl.find("llvmpipe") != std::string::npos ||
+                gl.find("softpipe") != std::string::npos)
+        << gl;
+}

@@ -1,7 +1,10 @@
 #include "app/Outputs.h"
 
+#include <cstdio>
 #include <fstream>
 #include <stdexcept>
+
+#include "app/SceneReader.h"
 
 namespace rend {
 
@@ -44,32 +47,8 @@ void StatsWriter::finish() {
 }
 
 std::string jsonString(const std::string& text) {
-    std::string out = "\"";
-    for (char c : text) {
-        switch (c) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\t':
-                out += "\\t";
-                break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) {
-                    char buf[8];
-                    std::snprintf(buf, sizeof buf, "\\u%04x", c);
-                    out += buf;
-                } else {
-                    out += c;
-                }
-        }
-    }
-    return out + "\"";
+    // TOML basic strings and JSON strings share their escapes (\", \\, \uXXXX).
+    return scene::tomlString(text);
 }
 
 }  // namespace rend

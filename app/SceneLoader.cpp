@@ -144,7 +144,7 @@ sim::SheetParams readSheet(const TableReader& root) {
     readOutline(t, s);
     s.center = t.vec3(kCenter).value_or(s.center);
     s.lattice = sim::LatticeKind(t.choice(kLattice, kLattices).value_or(std::size_t(s.lattice)));
-    s.horizonFactor = t.number(kHorizon, Range::closed(1.0, 6.0)).value_or(s.horizonFactor);
+    s.horizonFactor = t.number(kHorizon, Range::openClosed(1.0, 6.0)).value_or(s.horizonFactor);
     s.thickness = t.number(kThickness, Range::positive()).value_or(s.thickness);
     s.perturbationAmplitude =
         t.number(kPerturbation, Range::nonNegative()).value_or(s.perturbationAmplitude);

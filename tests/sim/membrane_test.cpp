@@ -298,3 +298,33 @@ TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
     EXPECT_NEAR(m.velocities()[pulled].x(), 0.2, 1e-12);
     EXPECT_EQ(m.positions()[pinned], m.restPositions()[pinned]);
 }
+
+TEST(Lattice, DiscOutlineHoldsItsAreaWorthOfParticlesAllInside) {
+    MembraneParams p = smallSheet(LatticeKind::Hexagonal);
+    p.sheet.outline = Outline::Disc;
+    p.sheet.radius = 0.5;
+    p.sheet.center = {0.3, -0.2, 0.1};
+    Membrane m(p);
+    const double cellArea = 0.02 * 0.02 * std::sqrt(3.0) / 2.0;
+    EXPECT_NEAR(m.particleCount() * cellArea / (std::numbers::pi * 0.25), 1.0, 0.02);
+    for (const auto& x : m.restPositions()) {
+        EXPECT_LE((x.head<2>() - p.sheet.center.head<2>()).norm(), 0.5 + 1e-9);
+        EXPECT_EQ(x.z(), 0.1);
+    }
+}
+
+TEST(Membrane, FreeFallAcceleratesEveryParticleByGravityExactly) {
+    // A sheet at rest in its rest shape has no bond force, so every particle falls alike:
+    // symplectic Euler gives v = n dt g and z = -n (n+1) / 2 dt^2 g exactly up to rounding.
+    MembraneParams p = smallSheet(LatticeKind::Hexagonal, 0.2);
+    p.gravity = {0, 0, -9.81};
+    p.time.dt = 1e-3;
+    Membrane m(p);
+    const int n = 100;
+    for (int s = 0; s < n; ++s) m.step();
+    for (int i = 0; i < m.particleCount(); ++i) {
+        EXPECT_NEAR(m.velocities()[i].z(), -9.81 * n * 1e-3, 1e-12);
+        EXPECT_NEAR(m.positions()[i].z(), -9.81 * 1e-6 * n * (n + 1) / 2.0, 1e-12);
+    }
+    EXPECT_NEAR(m.strainEnergy(), 0.0, 1e-20);
+}

@@ -15,13 +15,9 @@ bool bondIntact(const sim::FrameView& frame, int bond) {
     return bond < 0 || frame.bondAlive[bond] != 0;
 }
 
-std::array<int, 3> edgeBonds(const sim::FrameView& rest, const std::array<int, 3>& t, bool rev) {
+std::array<int, 3> edgeBonds(const sim::FrameView& rest, const std::array<int, 3>& t) {
     std::array<int, 3> bonds{};
-    for (int e = 0; e < 3; ++e) {
-        const int a = t[e];
-        const int b = t[(e + 1) % 3];
-        bonds[e] = rev ? rest.findBond(b, a) : rest.findBond(a, b);
-    }
+    for (int e = 0; e < 3; ++e) bonds[e] = rest.findBond(t[e], t[(e + 1) % 3]);
     return bonds;
 }
 
@@ -46,12 +42,7 @@ std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& p
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()) {
     edgeBonds_.reserve(triangles_.size());
-    edgeBondsReverse_.reserve(triangles_.size());
-    for (const auto& t : triangles_) {
-        edgeBonds_.push_back(edgeBonds(rest, t, false));
-        // Both CSR copies are checked so a solver that marks only one end still cuts the sheet.
-        edgeBondsReverse_.push_back(edgeBonds(rest, t, true));
-    }
+    for (const auto& t : triangles_) edgeBonds_.push_back(edgeBonds(rest, t));
 }
 
 std::vector<int> LatticeSurface::keptTriangles(const sim::FrameView& frame) const {
@@ -59,10 +50,7 @@ std::vector<int> LatticeSurface::keptTriangles(const sim::FrameView& frame) cons
     kept.reserve(triangles_.size());
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
         bool intact = true;
-        for (int e = 0; e < 3; ++e) {
-            intact = intact && bondIntact(frame, edgeBonds_[t][e]) &&
-                     bondIntact(frame, edgeBondsReverse_[t][e]);
-        }
+        for (int e = 0; e < 3; ++e) intact = intact && bondIntact(frame, edgeBonds_[t][e]);
         if (intact) kept.push_back(static_cast<int>(t));
     }
     return kept;

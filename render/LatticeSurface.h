@@ -26,8 +26,7 @@ public:
 
 private:
     std::vector<std::array<int, 3>> triangles_;
-    std::vector<std::array<int, 3>> edgeBonds_;         ///< bond index per edge (i->j), -1 if none
-    std::vector<std::array<int, 3>> edgeBondsReverse_;  ///< the same bonds stored as j->i
+    std::vector<std::array<int, 3>> edgeBonds_;  ///< bond index per edge (i->j), -1 if none
 };
 
 }  // namespace rend::render

@@ -29,7 +29,9 @@ struct FrameView {
     std::span<const int> bondOffsets;
     std::span<const int> bondPartners;
     std::span<const double> bondRestLength;
-    std::span<const std::uint8_t> bondAlive;  ///< 1 intact, 0 broken
+    /// 1 intact, 0 broken. The two copies of a bond (i->j and j->i) always agree: the solver
+    /// breaks a bond from both ends, so a reader may look at either.
+    std::span<const std::uint8_t> bondAlive;
 
     std::size_t particleCount() const { return positions.size(); }
 

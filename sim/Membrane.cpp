@@ -108,7 +108,7 @@ void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
     const int n = particleCount();
     force.resize(n);
     const auto& offsets = bonds_.offsets;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         const Eigen::Vector3d xi = x_[i];
@@ -141,7 +141,7 @@ void Membrane::integrate() {
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
     bool bad = false;
-#pragma omp parallel for schedule(static) reduction(|| : bad)
+#pragma omp parallel for schedule(static) reduction(|| : bad) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         const std::int16_t c = constraint_[i];
         if (c == kFree)

@@ -32,6 +32,10 @@ class Membrane {
 public:
     explicit Membrane(const MembraneParams& params);
 
+    /// Below this many particles a step takes microseconds and waking the OpenMP team costs more
+    /// than it saves; the loop body is the same either way, so results do not change.
+    static constexpr int kParallelThreshold = 2048;
+
     int particleCount() const { return int(x0_.size()); }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }

@@ -209,12 +209,12 @@ TEST(PatchTest, EdgeSofteningIsReportedAndThePaperConstantIsNotCalibrated) {
 }
 
 TEST(Membrane, OneAndTwoThreadsGiveIdenticalBits) {
-    MembraneParams p = smallSheet(LatticeKind::Hexagonal, 0.5);
+    MembraneParams p = smallSheet(LatticeKind::Hexagonal, 1.0);
     p.sheet.perturbationAmplitude = 1e-4;
     BoundaryCondition left, right;
     left.kind = right.kind = BoundaryKind::Velocity;
-    left.region.max.x() = -0.24;
-    right.region.min.x() = 0.24;
+    left.region.max.x() = -0.49;
+    right.region.min.x() = 0.49;
     left.velocity = {-0.1, 0, 0.02};
     right.velocity = {0.1, 0, 0};
     left.rampTime = right.rampTime = 0.01;
@@ -223,6 +223,7 @@ TEST(Membrane, OneAndTwoThreadsGiveIdenticalBits) {
     auto run = [&](int threads) {
         omp_set_num_threads(threads);
         Membrane m(p);
+        EXPECT_GT(m.particleCount(), Membrane::kParallelThreshold) << "must take the parallel path";
         for (int s = 0; s < 400; ++s) m.step();
         return m.positions();
     };

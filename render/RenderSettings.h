@@ -7,7 +7,9 @@
 
 namespace rend::render {
 
-enum class ColorBy { None, Speed, Strain };
+/// Theta: the diffusive quantity, light red -> dark red as in the membrane paper's figures.
+/// Damage: per-particle damage in [0, 1].
+enum class ColorBy { None, Speed, Strain, Theta, Damage };
 
 struct Camera {
     Eigen::Vector3d position{0.0, -4.0, 3.0};

@@ -27,20 +27,6 @@ struct SheetParams {
     std::uint64_t perturbationSeed = 1;
 };
 
-/// How the micromodulus c of eq. 18 is chosen.
-enum class MicromodulusMode {
-    Calibrated,  ///< uniform small strain reproduces E in the interior (see BondLaw.h)
-    Paper,       ///< the paper's literal c = 18K/(pi R^4) (eq. 24), kept for comparison
-};
-
-struct MaterialParams {
-    std::string name = "custom";
-    double youngsModulus = 2e4;  ///< E [Pa]
-    double poissonRatio = 0.3;  ///< used only by the paper's literal constant; bond-based fixes 1/3
-    double density = 5000.0;    ///< rho [kg/m^3]
-    MicromodulusMode micromodulus = MicromodulusMode::Calibrated;
-};
-
 /// Axis-aligned box in rest coordinates (x, y); particles whose rest position lies inside
 /// belong to the region. Unbounded sides are +-infinity.
 struct Region {
@@ -51,6 +37,90 @@ struct Region {
     bool contains(const Eigen::Vector3d& x0) const {
         return x0.x() >= min.x() && x0.x() <= max.x() && x0.y() >= min.y() && x0.y() <= max.y();
     }
+};
+
+/// How the micromodulus c of eq. 18 is chosen.
+enum class MicromodulusMode {
+    Calibrated,  ///< uniform small strain reproduces E in the interior (see BondLaw.h)
+    Paper,       ///< the paper's literal c = 18K/(pi R^4) (eq. 24), kept for comparison
+};
+
+/// The three bond laws of the membrane paper (eqs. 18-20).
+enum class BondLawKind {
+    Linear,         ///< eq. 18: f = c eta
+    PowerLaw,       ///< eq. 19: rubber, c (s^2 + 1/s^2) + c* s^n energy
+    Elastoplastic,  ///< eq. 20: linear up to eta0, exponential softening beyond
+};
+
+/// How the critical stretch is derived from the fracture energy G_f.
+enum class CriticalStretchMode {
+    Calibrated,  ///< the energy of the bonds crossing a unit crack equals G_f (see Fracture.h)
+    Paper,       ///< eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R))
+};
+
+struct MaterialParams {
+    std::string name = "custom";
+    double youngsModulus = 2e4;  ///< E [Pa]
+    double poissonRatio = 0.3;  ///< used only by the paper's literal constant; bond-based fixes 1/3
+    double density = 5000.0;    ///< rho [kg/m^3]
+    MicromodulusMode micromodulus = MicromodulusMode::Calibrated;
+
+    BondLawKind law = BondLawKind::Linear;
+    double powerLawRatio = 0.0;     ///< c* / c of eq. 19, <= 0
+    double powerLawExponent = 4.0;  ///< n of eq. 19, > 1
+    double yieldStrain = 1e-4;      ///< eta0 of eqs. 20 and 27
+    double softening = 1.0;         ///< beta of eqs. 20 and 27, > 0
+
+    std::optional<double> fractureEnergy;  ///< G_f [J/m^2]; nullopt: bonds never break
+    CriticalStretchMode criticalStretch = CriticalStretchMode::Calibrated;
+
+    double capacity = 1.0;      ///< diffusive capacity C (eq. 25)
+    double conductivity = 0.0;  ///< coefficient of diffusion k (eq. 25); 0: no diffusion
+    double expansion = 0.0;     ///< alpha: strain per unit theta (eqs. 18-20)
+    /// Degradation by the diffusive quantity (acid, moisture): stiffness and critical stretch
+    /// scale by max(0, 1 - loss * theta_bar).
+    double stiffnessLoss = 0.0;
+    double strengthLoss = 0.0;
+};
+
+/// A pre-notch: a polyline in rest coordinates (x, y); every bond crossing it is broken at set-up.
+struct Notch {
+    std::vector<Eigen::Vector2d> points;
+};
+
+/// Source of the diffusive quantity, adding `rate` [theta units per second] to every particle
+/// within `radius` of its centre while start <= t < start + duration.
+struct DiffusionSpot {
+    Eigen::Vector2d center{0, 0};
+    double radius = 0.05;
+    double rate = 1.0;
+    double start = 0.0;
+    double duration = std::numeric_limits<double>::infinity();
+};
+
+/// Seeded generators of spots: `count` spots placed uniformly over the sheet at t = start
+/// (heat spots), or a spray emitting `count` droplets uniformly over [start, start + spread).
+struct SpotScatter {
+    int count = 0;
+    double radius = 0.05;
+    double rate = 1.0;
+    double start = 0.0;
+    double spread = 0.0;  ///< 0: all at once; > 0: a spray over this many seconds
+    double duration = std::numeric_limits<double>::infinity();  ///< each spot's lifetime
+    std::uint64_t seed = 1;
+};
+
+/// Dirichlet edge source: theta is held at `value` on the particles of the region.
+struct DiffusionEdge {
+    Region region;
+    double value = 1.0;
+};
+
+struct DiffusionParams {
+    double initial = 0.0;               ///< theta everywhere at t = 0
+    std::vector<DiffusionSpot> spots;   ///< explicit sources (negative rate: sinks)
+    std::vector<SpotScatter> scatters;  ///< random spots and sprays, expanded at set-up
+    std::vector<DiffusionEdge> edges;   ///< edge sources: theta held fixed there
 };
 
 enum class BoundaryKind { Velocity, Pinned };
@@ -77,6 +147,8 @@ struct MembraneParams {
     Eigen::Vector3d gravity{0, 0, 0};
     double damping = 0.0;  ///< mass-proportional velocity damping [1/s]
     TimeParams time;
+    std::vector<Notch> notches;
+    DiffusionParams diffusion;
 };
 
 }  // namespace rend::sim

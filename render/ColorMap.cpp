@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace rend::render {
 
@@ -16,7 +17,40 @@ constexpr float kViridisSrgb[9][3] = {
     {0.369f, 0.789f, 0.383f}, {0.678f, 0.864f, 0.190f}, {0.993f, 0.906f, 0.144f},
 };
 
+// Light red -> dark red, the membrane paper's look for increasing theta, in sRGB. The middle
+// sample keeps the midrange a saturated red; a straight line between the ends passes through a
+// greyish rose. Every channel falls monotonically, so luminance does too.
+constexpr float kThetaSrgb[3][3] = {
+    {1.00f, 0.85f, 0.82f},
+    {0.84f, 0.30f, 0.26f},
+    {0.45f, 0.00f, 0.02f},
+};
+
 float srgbToLinear(float c) { return std::pow(c, 2.2f); }
+
+// Piecewise-linear interpolation of an sRGB table at t in [0,1], linearised at the end.
+template <std::size_t N>
+Eigen::Vector3f sampleSrgb(const float (&table)[N][3], double t) {
+    static_assert(N >= 2);
+    const double clamped = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
+    const double x = clamped * double(N - 1);
+    const int k = std::min(static_cast<int>(x), static_cast<int>(N) - 2);
+    const float f = static_cast<float>(x - k);
+    Eigen::Vector3f c;
+    for (int ch = 0; ch < 3; ++ch) {
+        const float s = table[k][ch] * (1.0f - f) + table[k + 1][ch] * f;
+        c[ch] = srgbToLinear(s);
+    }
+    return c;
+}
+
+// A field stored by the simulator (theta, damage); zeros where the frame has none, so that a
+// scene without that physics renders as the low end rather than failing.
+std::vector<double> storedField(const sim::FrameView& frame, std::span<const double> values) {
+    std::vector<double> out(frame.particleCount(), 0.0);
+    std::copy_n(values.begin(), std::min(out.size(), values.size()), out.begin());
+    return out;
+}
 
 std::vector<double> speeds(const sim::FrameView& frame) {
     std::vector<double> out(frame.particleCount(), 0.0);
@@ -62,24 +96,19 @@ std::vector<double> particleField(const sim::FrameView& frame, ColorBy by) {
             return speeds(frame);
         case ColorBy::Strain:
             return strains(frame);
+        case ColorBy::Theta:
+            return storedField(frame, frame.theta);
+        case ColorBy::Damage:
+            return storedField(frame, frame.damage);
         case ColorBy::None:
             break;
     }
     return {};
 }
 
-Eigen::Vector3f colormap(double t) {
-    const double clamped = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0);
-    const double x = clamped * 8.0;
-    const int k = std::min(static_cast<int>(x), 7);
-    const float f = static_cast<float>(x - k);
-    Eigen::Vector3f c;
-    for (int ch = 0; ch < 3; ++ch) {
-        const float s = kViridisSrgb[k][ch] * (1.0f - f) + kViridisSrgb[k + 1][ch] * f;
-        c[ch] = srgbToLinear(s);
-    }
-    return c;
-}
+Eigen::Vector3f colormap(double t) { return sampleSrgb(kViridisSrgb, t); }
+
+Eigen::Vector3f thetaColormap(double t) { return sampleSrgb(kThetaSrgb, t); }
 
 std::vector<Eigen::Vector3f> particleColors(const sim::FrameView& frame,
                                             const RenderSettings& settings) {
@@ -89,9 +118,10 @@ std::vector<Eigen::Vector3f> particleColors(const sim::FrameView& frame,
     const std::vector<double> field = particleField(frame, settings.colorBy);
     const auto [lo, hi] = fieldRange(field, settings);
     const double span = hi - lo;
+    const auto map = settings.colorBy == ColorBy::Theta ? thetaColormap : colormap;
     std::vector<Eigen::Vector3f> colors;
     colors.reserve(n);
-    for (double v : field) colors.push_back(colormap(span > 0.0 ? (v - lo) / span : 0.0));
+    for (double v : field) colors.push_back(map(span > 0.0 ? (v - lo) / span : 0.0));
     return colors;
 }
 

@@ -1,13 +1,18 @@
 #include "render/LatticeSurface.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <unordered_map>
 
 #include "render/ColorMap.h"
 
 namespace rend::render {
 
 namespace {
+
+constexpr std::uint32_t kUnassigned = std::numeric_limits<std::uint32_t>::max();
 
 bool bondIntact(const sim::FrameView& frame, int bond) {
     // Edges without a bond (e.g. square-lattice diagonals) carry no damage information, so
@@ -37,38 +42,136 @@ std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& p
     return normals;
 }
 
+// Pairs every interior edge with the triangle on its other side. The rest lattice is a planar
+// triangulation, so an edge has at most two triangles; a third (never produced by sim/) is
+// left unpaired rather than guessed at.
+std::vector<std::array<int, 3>> edgeNeighbours(const std::vector<std::array<int, 3>>& tris) {
+    std::vector<std::array<int, 3>> neighbours(tris.size(), {-1, -1, -1});
+    std::unordered_map<std::uint64_t, std::array<int, 2>> firstSide;  // (triangle, edge)
+    firstSide.reserve(tris.size() * 2);
+    for (int t = 0; t < static_cast<int>(tris.size()); ++t) {
+        for (int e = 0; e < 3; ++e) {
+            const auto [a, b] = std::minmax(tris[t][e], tris[t][(e + 1) % 3]);
+            const std::uint64_t key = (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+            const auto [it, inserted] = firstSide.try_emplace(key, std::array<int, 2>{t, e});
+            if (inserted || neighbours[it->second[0]][it->second[1]] >= 0) continue;
+            neighbours[it->second[0]][it->second[1]] = t;
+            neighbours[t][e] = it->second[0];
+        }
+    }
+    return neighbours;
+}
+
+int vertexCount(const sim::FrameView& rest, const std::vector<std::array<int, 3>>& tris) {
+    int n = static_cast<int>(rest.particleCount());
+    for (const auto& t : tris) n = std::max(n, 1 + std::max({t[0], t[1], t[2]}));
+    return n;
+}
+
 }  // namespace
 
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
-    : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()) {
+    : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
+      edgeNeighbours_(edgeNeighbours(triangles_)) {
     edgeBonds_.reserve(triangles_.size());
     for (const auto& t : triangles_) edgeBonds_.push_back(edgeBonds(rest, t));
+    // Counting sort by particle: the lists come out in ascending triangle order, which fixes
+    // which fan keeps the particle's own vertex.
+    incidentOffsets_.assign(vertexCount(rest, triangles_) + 1, 0);
+    for (const auto& t : triangles_)
+        for (int v : t) ++incidentOffsets_[v + 1];
+    for (std::size_t i = 1; i < incidentOffsets_.size(); ++i)
+        incidentOffsets_[i] += incidentOffsets_[i - 1];
+    incident_.resize(incidentOffsets_.back());
+    std::vector<int> fill(incidentOffsets_.begin(), incidentOffsets_.end() - 1);
+    for (int t = 0; t < static_cast<int>(triangles_.size()); ++t)
+        for (int v : triangles_[t]) incident_[fill[v]++] = t;
 }
 
-std::vector<int> LatticeSurface::keptTriangles(const sim::FrameView& frame) const {
-    std::vector<int> kept;
-    kept.reserve(triangles_.size());
+std::vector<std::uint8_t> LatticeSurface::keptFlags(const sim::FrameView& frame) const {
+    std::vector<std::uint8_t> kept(triangles_.size(), 0);
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
         bool intact = true;
         for (int e = 0; e < 3; ++e) intact = intact && bondIntact(frame, edgeBonds_[t][e]);
-        if (intact) kept.push_back(static_cast<int>(t));
+        kept[t] = intact ? 1 : 0;
     }
     return kept;
 }
 
+std::vector<int> LatticeSurface::keptTriangles(const sim::FrameView& frame) const {
+    const std::vector<std::uint8_t> flags = keptFlags(frame);
+    std::vector<int> kept;
+    kept.reserve(triangles_.size());
+    for (std::size_t t = 0; t < flags.size(); ++t)
+        if (flags[t]) kept.push_back(static_cast<int>(t));
+    return kept;
+}
+
+int LatticeSurface::cornerOf(int triangle, int particle) const {
+    const auto& t = triangles_[triangle];
+    return t[0] == particle ? 0 : (t[1] == particle ? 1 : 2);
+}
+
+// Gives `vertex` to particle's corner in every kept triangle reachable from `start` across
+// kept edges through the particle (two triangles both holding the particle and sharing an
+// edge share one through it, so only the two edges at its corner need following).
+void LatticeSurface::walkFan(int start, int particle, std::uint32_t vertex,
+                             const std::vector<std::uint8_t>& kept, Corners& corners,
+                             std::vector<int>& stack) const {
+    stack.assign(1, start);
+    corners.vertex[start][cornerOf(start, particle)] = vertex;
+    while (!stack.empty()) {
+        const int t = stack.back();
+        stack.pop_back();
+        const int c = cornerOf(t, particle);
+        for (int e : {c, (c + 2) % 3}) {
+            const int n = edgeNeighbours_[t][e];
+            if (n < 0 || !kept[n]) continue;
+            std::uint32_t& slot = corners.vertex[n][cornerOf(n, particle)];
+            if (slot != kUnassigned) continue;
+            slot = vertex;
+            stack.push_back(n);
+        }
+    }
+}
+
+LatticeSurface::Corners LatticeSurface::splitFans(const std::vector<std::uint8_t>& kept,
+                                                  std::size_t particleCount) const {
+    Corners corners;
+    corners.vertex.assign(triangles_.size(), {kUnassigned, kUnassigned, kUnassigned});
+    std::vector<int> stack;
+    for (int p = 0; p + 1 < static_cast<int>(incidentOffsets_.size()); ++p) {
+        bool first = true;
+        for (int k = incidentOffsets_[p]; k < incidentOffsets_[p + 1]; ++k) {
+            const int t = incident_[k];
+            if (!kept[t] || corners.vertex[t][cornerOf(t, p)] != kUnassigned) continue;
+            std::uint32_t vertex = static_cast<std::uint32_t>(p);
+            if (!first) {
+                vertex = static_cast<std::uint32_t>(particleCount + corners.copyOf.size());
+                corners.copyOf.push_back(p);
+            }
+            first = false;
+            walkFan(t, p, vertex, kept, corners, stack);
+        }
+    }
+    return corners;
+}
+
 Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& settings) const {
+    const std::vector<std::uint8_t> kept = keptFlags(frame);
+    const std::size_t n = frame.particleCount();
+    const Corners corners = splitFans(kept, n);
     Mesh mesh;
     // Every particle stays a vertex so indices match the frame; unreferenced ones are harmless.
-    mesh.positions.reserve(frame.particleCount());
+    mesh.positions.reserve(n + corners.copyOf.size());
     for (const auto& p : frame.positions) mesh.positions.push_back(p.cast<float>());
-    for (int t : keptTriangles(frame)) {
-        const auto& tri = triangles_[t];
-        mesh.triangles.push_back({static_cast<std::uint32_t>(tri[0]),
-                                  static_cast<std::uint32_t>(tri[1]),
-                                  static_cast<std::uint32_t>(tri[2])});
-    }
+    for (int p : corners.copyOf) mesh.positions.push_back(mesh.positions[p]);
+    for (std::size_t t = 0; t < triangles_.size(); ++t)
+        if (kept[t]) mesh.triangles.push_back(corners.vertex[t]);
     mesh.normals = smoothNormals(mesh.positions, mesh.triangles);
     mesh.colors = particleColors(frame, settings);
+    mesh.colors.reserve(mesh.positions.size());
+    for (int p : corners.copyOf) mesh.colors.push_back(mesh.colors[p]);
     return mesh;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Linear micro-spring law of the membrane paper (seeds/000, eqs. 12 and 18), written in a
+// Micro-spring laws of the membrane paper (seeds/000, eqs. 12-14 and 18-20), written in a
 // dimensionally consistent membrane form.
 //
 // The paper's bond energy is Psi = c eta^2 / 2 with strain eta = |r|/|r0| - 1 (eq. 10), and the
@@ -21,6 +21,7 @@
 // together with its literal eq. 22 (areas A_j instead of volumes); its units do not close, so its
 // effective modulus depends on dx, R and h. The patch-test report prints both.
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -28,12 +29,107 @@
 
 namespace rend::sim {
 
-struct LinearBondLaw {
-    double c = 0.0;  ///< micromodulus
+/// Irreversible state of one bond of the elastoplastic law (eq. 20 and the damage of eq. 27):
+/// the largest mechanical strain it has reached.
+struct PlasticState {
+    double maxStrain = 0.0;
+};
 
-    double force(double eta) const { return c * eta; }               ///< eq. 18 (no diffusion yet)
-    double energy(double eta) const { return 0.5 * c * eta * eta; }  ///< eq. 12
-    double stiffness() const { return c; }                           ///< d force / d eta at rest
+/// One bond law with all three of the paper's forms. `eta` is always the mechanical strain: the
+/// diffusion-driven part alpha * theta_bar is removed by the caller (eqs. 18-20 subtract it).
+///
+/// Every law is scaled so that its small-strain stiffness df/deta at rest is c, the calibrated
+/// micromodulus: a scene's E means the same thing whatever the law.
+struct BondLaw {
+    BondLawKind kind = BondLawKind::Linear;
+    double c = 0.0;  ///< micromodulus: df/deta at rest
+
+    // Power law (eq. 13/19), with s = 1 + eta. The printed energy c (s^2 + 1/s^2) + c* s^n has
+    // a non-zero force at rest; we subtract its value and slope at s = 1 so the rest state is
+    // force- and energy-free:  Psi = cp (s^2 + s^-2 - 2) + c* (s^n - 1 - n (s - 1)).
+    // Small-strain stiffness 8 cp + c* n (n - 1) = c fixes cp.
+    double powerC = 0.0;
+    double powerCStar = 0.0;  ///< c* = ratio * c, <= 0
+    double powerN = 4.0;
+
+    // Elastoplastic (eq. 14/20): linear up to eta0; loaded beyond, the bond follows eq. 20,
+    // f = c eta0 exp(-beta (eta - eta0)/eta0), and its strength left is eq. 27's gamma at the
+    // largest strain reached. Unloading is elastic (slope c) down to the permanent strain
+    // eta_max - f(eta_max)/c, so a crumpled foil keeps its crumples.
+    double yieldStrain = 1e-4;
+    double softening = 1.0;
+
+    static BondLaw fromMaterial(const MaterialParams& m, double micromodulus) {
+        BondLaw law;
+        law.kind = m.law;
+        law.c = micromodulus;
+        law.powerN = m.powerLawExponent;
+        law.powerCStar = m.powerLawRatio * micromodulus;
+        law.powerC = (micromodulus - law.powerCStar * law.powerN * (law.powerN - 1.0)) / 8.0;
+        law.yieldStrain = m.yieldStrain;
+        law.softening = m.softening;
+        return law;
+    }
+
+    double stiffness() const { return c; }
+
+    /// Eq. 20's force on the loading path at strain eta >= eta0.
+    double yieldForce(double eta) const {
+        return c * yieldStrain * std::exp(-softening * (eta - yieldStrain) / yieldStrain);
+    }
+
+    /// Permanent strain left after loading to maxStrain (0 while it stayed elastic).
+    double plasticStrain(const PlasticState& p) const {
+        return p.maxStrain > yieldStrain ? p.maxStrain - yieldForce(p.maxStrain) / c : 0.0;
+    }
+
+    /// eq. 27's gamma: the fraction of strength left (1 for elastic laws).
+    double strengthLeft(const PlasticState& p) const {
+        return kind == BondLawKind::Elastoplastic && p.maxStrain > yieldStrain
+                   ? yieldForce(p.maxStrain) / (c * yieldStrain)
+                   : 1.0;
+    }
+
+    /// f(eta) = dPsi/deta for the elastic laws and the current elastoplastic state.
+    double force(double eta, const PlasticState& p = {}) const {
+        switch (kind) {
+            case BondLawKind::Linear:
+                return c * eta;  // eq. 18
+            case BondLawKind::PowerLaw: {
+                const double s = 1.0 + eta;  // eq. 19
+                return 2.0 * powerC * (s - 1.0 / (s * s * s)) +
+                       powerCStar * powerN * (std::pow(s, powerN - 1.0) - 1.0);
+            }
+            case BondLawKind::Elastoplastic:
+                if (eta >= p.maxStrain && eta > yieldStrain) return yieldForce(eta);  // eq. 20
+                return c * (eta - plasticStrain(p));  // elastic, below the largest strain
+        }
+        return 0.0;
+    }
+
+    /// Psi(eta): the bond's stored (recoverable) energy.
+    double energy(double eta, const PlasticState& p = {}) const {
+        switch (kind) {
+            case BondLawKind::Linear:
+                return 0.5 * c * eta * eta;  // eq. 12
+            case BondLawKind::PowerLaw: {
+                const double s = 1.0 + eta;  // eq. 13
+                return powerC * (s * s + 1.0 / (s * s) - 2.0) +
+                       powerCStar * (std::pow(s, powerN) - 1.0 - powerN * eta);
+            }
+            case BondLawKind::Elastoplastic: {
+                const double e = eta - plasticStrain(p);  // eq. 14's recoverable part
+                return 0.5 * c * e * e;
+            }
+        }
+        return 0.0;
+    }
+
+    /// Records the strain a bond has reached: the only irreversible part of eq. 20.
+    PlasticState yieldStep(double eta, PlasticState p) const {
+        if (kind == BondLawKind::Elastoplastic) p.maxStrain = std::max(p.maxStrain, eta);
+        return p;
+    }
 };
 
 /// c = 6E / sum_j W0_ij V_j, with `interiorWeightedVolume` = max over particles of that sum.

@@ -2,22 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "sim/Fracture.h"
+
 namespace rend::sim {
-namespace {
-
-// splitmix64 (Steele, Lea & Flood 2014): a per-particle hash, so the perturbation of a
-// particle does not depend on how many particles came before it or on the thread count.
-double uniformFromHash(std::uint64_t seed, std::uint64_t index) {
-    std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (index + 1);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return double(z >> 11) * 0x1.0p-53;
-}
-
-}  // namespace
 
 Membrane::Membrane(const MembraneParams& params)
     : params_(params), lattice_(generateLattice(params.sheet)) {
@@ -30,12 +20,18 @@ Membrane::Membrane(const MembraneParams& params)
     mass_.assign(n, params.material.density * lattice_.particleArea * sheet.thickness);
     bonds_ = buildBondFamilies(x0_, horizon_);
     computeBondScales(params);
+    setUpFracture(params);
     assignBoundaries();
     x_ = x0_;
     perturb(sheet.perturbationAmplitude, sheet.perturbationSeed);
     v_.assign(n, Eigen::Vector3d::Zero());
     force_.assign(n, Eigen::Vector3d::Zero());
+    if (Diffusion::needed(params)) {
+        diffusion_.emplace(params, x0_, bonds_, volume_);
+        theta_ = diffusion_->initialTheta();
+    }
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
+    updateDamage();
 }
 
 void Membrane::computeBondScales(const MembraneParams& params) {
@@ -59,8 +55,9 @@ void Membrane::computeBondScales(const MembraneParams& params) {
         throw std::invalid_argument(
             "no particle has a bond with non-zero weight: raise the horizon");
     const MaterialParams& m = params.material;
-    law_.c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
-                   : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
+    const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
+                           : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
+    law_ = BondLaw::fromMaterial(m, c);
 
     double worstRatio = 0.0;  // max_i sum_j k_ij / m_i
     for (int i = 0; i < n; ++i) {
@@ -78,6 +75,27 @@ void Membrane::computeBondScales(const MembraneParams& params) {
     const double waveSpeed = params.sheet.dx * std::sqrt(worstRatio);
     speedLimit_ = 100.0 * waveSpeed + 10.0 * boundarySpeed +
                   2.0 * params.gravity.norm() * params.time.duration + 1e-6;
+}
+
+void Membrane::setUpFracture(const MembraneParams& params) {
+    const MaterialParams& m = params.material;
+    criticalStretch_ = std::numeric_limits<double>::infinity();
+    if (m.fractureEnergy) {
+        double interiorMoment = 0.0;  // max_i sum_j W0 |xi| V_j
+        for (int i = 0; i < particleCount(); ++i) {
+            double sum = 0.0;
+            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+                sum += bonds_.weight[b] * bonds_.restLength[b] * volume_[bonds_.partners[b]];
+            interiorMoment = std::max(interiorMoment, sum);
+        }
+        criticalStretch_ =
+            m.criticalStretch == CriticalStretchMode::Paper
+                ? paperCriticalStretch(*m.fractureEnergy, m.youngsModulus, horizon_)
+                : calibratedCriticalStretch(*m.fractureEnergy, law_.c, interiorMoment);
+    }
+    if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
+    notched_ = applyNotches(params.notches, x0_, bonds_);
+    canDamage_ = m.fractureEnergy.has_value() || !plastic_.empty() || notched_ > 0;
 }
 
 void Membrane::assignBoundaries() {
@@ -104,10 +122,27 @@ void Membrane::perturb(double amplitude, std::uint64_t seed) {
         x_[i].z() += amplitude * (2.0 * uniformFromHash(seed, std::uint64_t(i)) - 1.0);
 }
 
-void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
+double Membrane::mechanicalStrain(int i, int b, double length, double& thetaBar) const {
+    const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+    if (theta_.empty()) {
+        thetaBar = 0.0;
+        return eta;
+    }
+    // The printed eqs. 18-20 use theta_j alone; the mean is symmetric, so the pair forces stay
+    // equal and opposite and momentum is conserved.
+    thetaBar = 0.5 * (theta_[i] + theta_[bonds_.partners[b]]);
+    return eta - params_.material.expansion * thetaBar;
+}
+
+// Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
+// Both copies of a bond see the same strain bit for bit, so they break and yield together.
+template <bool kUpdateBonds>
+void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
     const int n = particleCount();
     force.resize(n);
     const auto& offsets = bonds_.offsets;
+    const bool plastic = !plastic_.empty();
+    const MaterialParams& m = params_.material;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -116,11 +151,27 @@ void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
             if (!bonds_.alive[b]) continue;
             const Eigen::Vector3d r = x_[bonds_.partners[b]] - xi;
             const double length = r.norm();
-            const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
-            sum += (bondScale_[b] * law_.force(eta) / length) * r;
+            double thetaBar;
+            const double eta = mechanicalStrain(i, b, length, thetaBar);
+            if (eta > criticalStretch_ * degradation(m.strengthLoss, thetaBar)) {  // eq. 27/28
+                if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
+                continue;
+            }
+            PlasticState state;
+            if (plastic) {
+                state = law_.yieldStep(eta, plastic_[b]);
+                if constexpr (kUpdateBonds) plastic_[b] = state;
+            }
+            const double f = degradation(m.stiffnessLoss, thetaBar) * law_.force(eta, state);
+            sum += (bondScale_[b] * f / length) * r;
         }
         force[i] = sum;
     }
+}
+
+void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
+    // With kUpdateBonds = false nothing of the membrane is written.
+    const_cast<Membrane*>(this)->bondForces<false>(force);
 }
 
 Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
@@ -153,14 +204,19 @@ void Membrane::integrate() {
         x_[i] += dt * v_[i];
         bad = bad || isBad(i);
     }
-    time_ = tNext;
-    ++steps_;
-    if (bad) reportBlowUp();
+    if (bad) {
+        time_ = tNext;
+        ++steps_;
+        reportBlowUp();
+    }
 }
 
 void Membrane::step() {
-    computeForces(force_);
+    bondForces<true>(force_);
     integrate();
+    if (diffusion_) diffusion_->advance(theta_, bonds_, time_, dt_);  // theta^n -> theta^n+1
+    time_ += dt_;
+    ++steps_;
 }
 
 void Membrane::reportBlowUp() const {
@@ -177,6 +233,21 @@ void Membrane::reportBlowUp() const {
     throw NumericalBlowUp(out.str(), steps_, culprit, suggested);
 }
 
+void Membrane::updateDamage() {
+    if (!canDamage_) return;
+    damage_.resize(particleCount());
+    for (int i = 0; i < particleCount(); ++i) {
+        double total = 0.0, intact = 0.0;
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            total += bonds_.weight[b];
+            if (bonds_.alive[b])
+                intact += bonds_.weight[b] *
+                          (plastic_.empty() ? 1.0 : law_.strengthLeft(plastic_[b]));  // eq. 27
+        }
+        damage_[i] = total > 0.0 ? 1.0 - intact / total : 0.0;
+    }
+}
+
 double Membrane::kineticEnergy() const {
     double sum = 0.0;
     for (int i = 0; i < particleCount(); ++i) sum += 0.5 * mass_[i] * v_[i].squaredNorm();
@@ -184,13 +255,18 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
+    const MaterialParams& m = params_.material;
     double sum = 0.0;
     for (int i = 0; i < particleCount(); ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             if (!bonds_.alive[b]) continue;
-            const double eta = (x_[bonds_.partners[b]] - x_[i]).norm() / bonds_.restLength[b] - 1.0;
+            double thetaBar;
+            const double length = (x_[bonds_.partners[b]] - x_[i]).norm();
+            const double eta = mechanicalStrain(i, b, length, thetaBar);
+            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
             // Each bond is stored from both ends: half of U_ij from each.
-            sum += 0.5 * bondScale_[b] * bonds_.restLength[b] * law_.energy(eta);
+            sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
+                   degradation(m.stiffnessLoss, thetaBar) * law_.energy(eta, state);
         }
     return sum;
 }
@@ -199,6 +275,10 @@ double Membrane::maxSpeed() const {
     double m = 0.0;
     for (const auto& v : v_) m = std::max(m, v.norm());
     return m;
+}
+
+double Membrane::maxTheta() const {
+    return theta_.empty() ? 0.0 : *std::max_element(theta_.begin(), theta_.end());
 }
 
 std::size_t Membrane::brokenBondCount() const {
@@ -212,13 +292,17 @@ Eigen::Vector3d Membrane::totalMomentum() const {
 }
 
 Eigen::Matrix3d Membrane::particleStress(int i) const {
+    const MaterialParams& m = params_.material;
     Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
     for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
         if (!bonds_.alive[b]) continue;
         const Eigen::Vector3d r = x_[bonds_.partners[b]] - x_[i];
         const double length = r.norm();
-        const double eta = length / bonds_.restLength[b] - 1.0;
-        sigma += (bondScale_[b] * law_.force(eta) / length) * r * r.transpose();
+        double thetaBar;
+        const double eta = mechanicalStrain(i, b, length, thetaBar);
+        const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
+        const double f = degradation(m.stiffnessLoss, thetaBar) * law_.force(eta, state);
+        sigma += (bondScale_[b] * f / length) * r * r.transpose();
     }
     return sigma / (2.0 * volume_[i]);
 }
@@ -230,6 +314,8 @@ FrameView Membrane::view(int frame) const {
     v.positions = x_;
     v.velocities = v_;
     v.restPositions = x0_;
+    v.theta = theta_;
+    v.damage = damage_;
     v.restTriangles = lattice_.triangles;
     v.bondOffsets = bonds_.offsets;
     v.bondPartners = bonds_.partners;
@@ -237,5 +323,8 @@ FrameView Membrane::view(int frame) const {
     v.bondAlive = bonds_.alive;
     return v;
 }
+
+template void Membrane::bondForces<true>(std::vector<Eigen::Vector3d>&);
+template void Membrane::bondForces<false>(std::vector<Eigen::Vector3d>&);
 
 }  // namespace rend::sim

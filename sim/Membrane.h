@@ -1,19 +1,24 @@
 #pragma once
 // The peridynamic membrane of the membrane paper (seeds/000_68a9cbaeb8170387.txt, Sections
-// 4.1-4.4): one layer of particles joined by micro-springs within the cutoff R, advanced with
-// the explicit symplectic Euler scheme of eq. 26 (velocity first, then position).
+// 4-5): one layer of particles joined by micro-springs within the cutoff R (three bond laws,
+// eqs. 18-20), broken for good past the critical stretch (eqs. 27-28), with a diffusive
+// quantity theta (eq. 25) that strains and weakens the bonds, advanced with the explicit
+// symplectic Euler scheme of eq. 26 (velocity first, then position).
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim/BondLaw.h"
 #include "sim/Bonds.h"
+#include "sim/Diffusion.h"
 #include "sim/FrameView.h"
 #include "sim/Lattice.h"
 #include "sim/Params.h"
+#include "sim/Random.h"
 
 namespace rend::sim {
 
@@ -32,14 +37,16 @@ class Membrane {
 public:
     explicit Membrane(const MembraneParams& params);
 
-    /// Below this many particles a step takes microseconds and waking the OpenMP team costs more
-    /// than it saves; the loop body is the same either way, so results do not change.
-    static constexpr int kParallelThreshold = 2048;
-
     int particleCount() const { return int(x0_.size()); }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }
     double micromodulus() const { return law_.c; }
+    const BondLaw& law() const { return law_; }
+    /// eta_c at theta = 0; +infinity when the material has no fracture energy.
+    double criticalStretch() const { return criticalStretch_; }
+    bool hasDiffusion() const { return diffusion_.has_value(); }
+    const Diffusion* diffusion() const { return diffusion_ ? &*diffusion_ : nullptr; }
+    std::size_t notchedBondCount() const { return notched_; }
 
     /// Silling & Askari (2005) bound for the explicit scheme, without safety factor:
     /// dt <= min_i sqrt(2 m_i / sum_j k_ij), k_ij the bond's axial stiffness at rest. It is the
@@ -50,16 +57,23 @@ public:
     double time() const { return time_; }
     long stepCount() const { return steps_; }
 
-    /// One explicit step: bond forces, then velocities, then positions (eq. 26). Throws
+    /// One explicit step (eq. 26): bond forces (breaking bonds past eta_c, yielding
+    /// elastoplastic ones), then velocities, then positions, then theta. Throws
     /// NumericalBlowUp naming the step and the first offending particle.
     void step();
 
-    /// Internal bond forces on every particle (eq. 22 with the current bond direction).
+    /// Internal bond forces on every particle (eq. 22 with the current bond direction), without
+    /// changing any bond's state.
     void computeForces(std::vector<Eigen::Vector3d>& force) const;
+
+    /// Recomputes the per-particle damage field: 1 - sum of intact weighted bond strength /
+    /// sum of initial weights. Called once per frame, not per step.
+    void updateDamage();
 
     double kineticEnergy() const;
     double strainEnergy() const;
     double maxSpeed() const;
+    double maxTheta() const;  ///< 0 without diffusion
     std::size_t brokenBondCount() const;
     Eigen::Vector3d totalMomentum() const;
     /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij.
@@ -71,6 +85,11 @@ public:
 
     std::vector<Eigen::Vector3d>& positions() { return x_; }
     std::vector<Eigen::Vector3d>& velocities() { return v_; }
+    std::vector<double>& theta() { return theta_; }  ///< empty without diffusion
+    const std::vector<double>& theta() const { return theta_; }
+    const std::vector<double>& damage() const { return damage_; }
+    /// Whether any bond can break or soften (fracture energy, elastoplastic law or notches).
+    bool canDamage() const { return canDamage_; }
     const std::vector<Eigen::Vector3d>& positions() const { return x_; }
     const std::vector<Eigen::Vector3d>& restPositions() const { return x0_; }
     const std::vector<double>& masses() const { return mass_; }
@@ -84,6 +103,14 @@ private:
     static constexpr std::int16_t kPinned = -2;
 
     void computeBondScales(const MembraneParams& params);
+    void setUpFracture(const MembraneParams& params);
+    template <bool kUpdateBonds>
+    void bondForces(std::vector<Eigen::Vector3d>& force);
+    /// Mechanical strain of bond b of particle i (diffusion strain removed) and its theta_bar.
+    double mechanicalStrain(int i, int b, double length, double& thetaBar) const;
+    double degradation(double loss, double thetaBar) const {
+        return std::max(0.0, 1.0 - loss * thetaBar);
+    }
     void assignBoundaries();
     void perturb(double amplitude, std::uint64_t seed);
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
@@ -94,7 +121,11 @@ private:
     MembraneParams params_;
     Lattice lattice_;
     BondFamilies bonds_;
-    LinearBondLaw law_;
+    BondLaw law_;
+    double criticalStretch_ = 0.0;
+    bool canDamage_ = false;
+    std::size_t notched_ = 0;
+    std::optional<Diffusion> diffusion_;
     double horizon_ = 0.0;
     double stableDt_ = 0.0;
     double dt_ = 0.0;
@@ -107,6 +138,9 @@ private:
     std::vector<double> mass_, volume_;
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
     std::vector<double> bondScale_;         ///< force on i per unit of f(eta), see BondLaw.h
+    std::vector<PlasticState> plastic_;     ///< per bond; empty unless the law is elastoplastic
+    std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
+    std::vector<double> damage_;            ///< per particle; empty unless canDamage_
 };
 
 }  // namespace rend::sim

@@ -9,9 +9,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <numbers>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "render/ColorMap.h"
 #include "render/Image.h"
@@ -189,6 +192,139 @@ TEST(LatticeSurface, IsolatedVertexGetsTheUpNormal) {
     EXPECT_TRUE(mesh.normals[0].isApprox(Eigen::Vector3f::UnitZ()));
 }
 
+namespace {
+
+// Breaks every bond that is not an edge of a triangle of a kept cell, so exactly those cells'
+// triangles survive.
+template <typename KeepCell>
+void keepOnlyCells(Sheet& sheet, KeepCell keep) {
+    std::set<std::pair<int, int>> edges;
+    for (int j = 0; j + 1 < sheet.ny; ++j) {
+        for (int i = 0; i + 1 < sheet.nx; ++i) {
+            if (!keep(i, j)) continue;
+            for (int t : {2 * (j * (sheet.nx - 1) + i), 2 * (j * (sheet.nx - 1) + i) + 1}) {
+                const auto& tri = sheet.triangles[t];
+                for (int e = 0; e < 3; ++e) edges.insert(std::minmax(tri[e], tri[(e + 1) % 3]));
+            }
+        }
+    }
+    for (int a = 0; a < static_cast<int>(sheet.positions.size()); ++a)
+        for (int b = sheet.offsets[a]; b < sheet.offsets[a + 1]; ++b)
+            if (!edges.count(std::minmax(a, sheet.partners[b])))
+                sheet.breakBond(a, sheet.partners[b]);
+}
+
+// Union-find over mesh vertices joined by triangles; returns each triangle's component root.
+std::vector<int> triangleComponents(const rend::render::Mesh& mesh) {
+    std::vector<int> parent(mesh.positions.size());
+    for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = static_cast<int>(v);
+    auto find = [&](int v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const auto& t : mesh.triangles) {
+        parent[find(int(t[1]))] = find(int(t[0]));
+        parent[find(int(t[2]))] = find(int(t[0]));
+    }
+    std::vector<int> roots;
+    for (const auto& t : mesh.triangles) roots.push_back(find(int(t[0])));
+    return roots;
+}
+
+void expectIndicesInRange(const rend::render::Mesh& mesh) {
+    ASSERT_EQ(mesh.positions.size(), mesh.normals.size());
+    ASSERT_EQ(mesh.positions.size(), mesh.colors.size());
+    for (const auto& t : mesh.triangles)
+        for (auto v : t) ASSERT_LT(v, mesh.positions.size());
+}
+
+}  // namespace
+
+TEST(LatticeSurfaceCracks, IntactSheetHasNoExtraVertices) {
+    const Sheet sheet(6, 5, 1.0);
+    const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), RenderSettings{});
+    EXPECT_EQ(mesh.positions.size(), sheet.positions.size());
+    EXPECT_EQ(triangleComponents(mesh).size(), sheet.triangles.size());
+}
+
+TEST(LatticeSurfaceCracks, SlitEndingInsideTheSheetAddsNoVertex) {
+    // One broken bond opens a slit, but every particle's kept triangles still form one fan.
+    Sheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
+    EXPECT_EQ(surface.build(sheet.view(), RenderSettings{}).positions.size(),
+              sheet.positions.size());
+}
+
+TEST(LatticeSurfaceCracks, BowtieParticleGetsExactlyOneCopy) {
+    // Keep the lower-left and upper-right quadrants of a 5 x 5 sheet: they touch only at (2,2).
+    Sheet sheet(5, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    keepOnlyCells(sheet, [](int i, int j) { return (i < 2) == (j < 2); });
+    sheet.positions[sheet.id(2, 2)] = Eigen::Vector3d(0.25, -0.5, 0.75);
+    RenderSettings settings;
+    settings.colorBy = ColorBy::Speed;
+    sheet.velocities[sheet.id(2, 2)] = Eigen::Vector3d(0.0, 0.0, 1.0);
+    const auto mesh = surface.build(sheet.view(), settings);
+    expectIndicesInRange(mesh);
+    ASSERT_EQ(mesh.positions.size(), sheet.positions.size() + 1);
+    const std::size_t pivot = sheet.id(2, 2);
+    EXPECT_EQ(mesh.positions.back(), mesh.positions[pivot]);
+    EXPECT_EQ(mesh.colors.back(), mesh.colors[pivot]);
+    // Each quadrant's triangles at the pivot use one of the two vertices, never both.
+    std::set<std::uint32_t> lowerLeft, upperRight;
+    for (const auto& t : mesh.triangles) {
+        for (auto v : t) {
+            if (v != pivot && v != mesh.positions.size() - 1) continue;
+            const bool upper = std::all_of(t.begin(), t.end(), [&](std::uint32_t w) {
+                return w >= sheet.positions.size() || sheet.rest[w].x() >= 0.0;
+            });
+            (upper ? upperRight : lowerLeft).insert(v);
+        }
+    }
+    EXPECT_EQ(lowerLeft.size(), 1u);
+    EXPECT_EQ(upperRight.size(), 1u);
+    EXPECT_NE(*lowerLeft.begin(), *upperRight.begin());
+}
+
+TEST(LatticeSurfaceCracks, SheetCutFullyAcrossFallsIntoTwoPiecesSharingNoVertex) {
+    // Break every bond crossing the anti-diagonal line i + j = n - 1, which runs through
+    // particles: the two halves touch at each of the n - 2 interior particles on the line.
+    constexpr int n = 7;
+    Sheet sheet(n, n, 1.0);
+    const LatticeSurface surface(sheet.view());
+    auto side = [&](int p) { return (p % n + p / n > n - 1) - (p % n + p / n < n - 1); };
+    for (int a = 0; a < n * n; ++a)
+        for (int b = sheet.offsets[a]; b < sheet.offsets[a + 1]; ++b)
+            if (side(a) * side(sheet.partners[b]) < 0) sheet.breakBond(a, sheet.partners[b]);
+    // Tilt the upper half about the crack; the lower half stays flat.
+    for (int p = 0; p < n * n; ++p)
+        if (side(p) > 0) sheet.positions[p].z() = 0.5 * (p % n + p / n - (n - 1));
+    const auto mesh = surface.build(sheet.view(), RenderSettings{});
+    expectIndicesInRange(mesh);
+    EXPECT_EQ(mesh.positions.size(), sheet.positions.size() + (n - 2));
+
+    const std::vector<int> roots = triangleComponents(mesh);
+    const std::set<int> components(roots.begin(), roots.end());
+    ASSERT_EQ(components.size(), 2u);
+    std::map<std::uint32_t, int> owner;  // vertex -> component
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        for (auto v : mesh.triangles[t]) {
+            const auto [it, inserted] = owner.emplace(v, roots[t]);
+            EXPECT_EQ(it->second, roots[t]) << "vertex " << v << " is in both pieces";
+        }
+    }
+    // Normals stay unit, and the flat half's are exactly up even where it touches the tilted
+    // half: no shading bleeds across the crack.
+    // Triangle 0 is in cell (0, 0), on the flat side.
+    for (const auto& [v, root] : owner) {
+        EXPECT_NEAR(mesh.normals[v].norm(), 1.0f, 1e-6f);
+        if (root == roots.front()) {
+            EXPECT_NEAR(mesh.normals[v].z(), 1.0f, 1e-6f) << v;
+        }
+    }
+}
+
 // ---- Colour map ----------------------------------------------------------------------------
 
 TEST(ColorMap, RunsFromDarkBlueToBrightYellow) {
@@ -266,6 +402,71 @@ TEST(ColorMap, AllZeroFieldMapsToTheLowEnd) {
     settings.colorBy = ColorBy::Speed;
     for (const auto& c : rend::render::particleColors(sheet.view(), settings))
         EXPECT_TRUE(c.isApprox(rend::render::colormap(0.0)));
+}
+
+TEST(ColorMap, ThetaRunsFromLightRedToDarkRed) {
+    using rend::render::thetaColormap;
+    const Eigen::Vector3f light = thetaColormap(0.0);
+    const Eigen::Vector3f dark = thetaColormap(1.0);
+    for (const Eigen::Vector3f& c : {light, dark}) {
+        EXPECT_GT(c.x(), c.y());  // red dominates at both ends
+        EXPECT_GT(c.x(), c.z());
+    }
+    EXPECT_GT(luminance(light), 0.6);  // a light, slightly pink material
+    EXPECT_GT(light.y(), 0.5f * light.x());
+    EXPECT_LT(luminance(dark), 0.06);
+    EXPECT_LT(dark.y(), 0.05f * dark.x());  // a deep, saturated red
+    EXPECT_GT(dark.x(), 0.1f);
+    EXPECT_TRUE(thetaColormap(-1.0).isApprox(light));
+    EXPECT_TRUE(thetaColormap(2.0).isApprox(dark));
+    EXPECT_TRUE(thetaColormap(std::nan("")).isApprox(light));
+}
+
+TEST(ColorMap, ThetaBrightnessFallsMonotonically) {
+    double previous = 2.0;
+    for (int k = 0; k <= 64; ++k) {
+        const double l = luminance(rend::render::thetaColormap(k / 64.0));
+        EXPECT_LT(l, previous) << "at t = " << k / 64.0;
+        previous = l;
+    }
+}
+
+TEST(ColorMap, ThetaAndDamageFieldsAreTheFrameValuesOrZeros) {
+    Sheet sheet(2, 2, 1.0);
+    const std::vector<double> theta{0.0, 0.5, 1.5, 3.0};
+    const std::vector<double> damage{0.25, 0.0, 1.0, 0.5};
+    EXPECT_EQ(rend::render::particleField(sheet.view(), ColorBy::Theta),
+              std::vector<double>(4, 0.0));
+    EXPECT_EQ(rend::render::particleField(sheet.view(), ColorBy::Damage),
+              std::vector<double>(4, 0.0));
+    FrameView view = sheet.view();
+    view.theta = theta;
+    view.damage = damage;
+    EXPECT_EQ(rend::render::particleField(view, ColorBy::Theta), theta);
+    EXPECT_EQ(rend::render::particleField(view, ColorBy::Damage), damage);
+}
+
+TEST(ColorMap, ThetaUsesTheRedMapAndDamageViridis) {
+    Sheet sheet(2, 2, 1.0);
+    const std::vector<double> values{0.0, 1.0, 2.0, 4.0};
+    FrameView view = sheet.view();
+    view.theta = values;
+    view.damage = values;
+    RenderSettings settings;
+    settings.colorBy = ColorBy::Theta;
+    auto colors = rend::render::particleColors(view, settings);
+    EXPECT_TRUE(colors[0].isApprox(rend::render::thetaColormap(0.0)));
+    EXPECT_TRUE(colors[2].isApprox(rend::render::thetaColormap(0.5)));
+    EXPECT_TRUE(colors[3].isApprox(rend::render::thetaColormap(1.0)));
+    settings.colorBy = ColorBy::Damage;
+    settings.colorRange = std::array<double, 2>{0.0, 8.0};
+    colors = rend::render::particleColors(view, settings);
+    EXPECT_TRUE(colors[3].isApprox(rend::render::colormap(0.5)));
+    // A frame without theta is uniformly the light end, not an error.
+    settings.colorBy = ColorBy::Theta;
+    settings.colorRange.reset();
+    for (const auto& c : rend::render::particleColors(sheet.view(), settings))
+        EXPECT_TRUE(c.isApprox(rend::render::thetaColormap(0.0)));
 }
 
 // ---- PNG I/O and comparison ----------------------------------------------------------------

@@ -223,7 +223,7 @@ TEST(Membrane, OneAndTwoThreadsGiveIdenticalBits) {
     auto run = [&](int threads) {
         omp_set_num_threads(threads);
         Membrane m(p);
-        EXPECT_GT(m.particleCount(), Membrane::kParallelThreshold) << "must take the parallel path";
+        EXPECT_GT(m.particleCount(), kParallelThreshold) << "must take the parallel path";
         for (int s = 0; s < 400; ++s) m.step();
         return m.positions();
     };

@@ -1,0 +1,103 @@
+#include "sim/Diffusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/Random.h"
+
+namespace rend::sim {
+
+bool Diffusion::needed(const MembraneParams& p) {
+    const DiffusionParams& d = p.diffusion;
+    return !d.spots.empty() || !d.scatters.empty() || !d.edges.empty() || d.initial != 0.0;
+}
+
+Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector3d> rest,
+                     const BondFamilies& bonds, std::span<const double> volumes)
+    : initial_(params.diffusion.initial), particles_(bonds.particleCount()) {
+    const MaterialParams& m = params.material;
+    const int n = bonds.particleCount();
+    double interior = 0.0;
+    for (int i = 0; i < n; ++i) {
+        double sum = 0.0;
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+            sum += bonds.weight[b] * volumes[bonds.partners[b]];
+        interior = std::max(interior, sum);
+    }
+    K_ = interior > 0.0 ? 4.0 * m.conductivity / interior : 0.0;
+    const double rhoC = m.density * m.capacity;
+    rate_.resize(bonds.directedCount());
+    double worst = 0.0;
+    for (int i = 0; i < n; ++i) {
+        double total = 0.0;
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            const double xi = bonds.restLength[b];
+            rate_[b] = K_ * bonds.weight[b] * volumes[bonds.partners[b]] / (rhoC * xi * xi);
+            total += rate_[b];
+        }
+        worst = std::max(worst, total);
+    }
+    stableDt_ = worst > 0.0 ? 1.0 / worst : std::numeric_limits<double>::infinity();
+    for (const DiffusionSpot& spot : params.diffusion.spots) addSpot(spot, rest);
+    for (const SpotScatter& scatter : params.diffusion.scatters) expandScatter(scatter, rest);
+    for (const DiffusionEdge& edge : params.diffusion.edges)
+        for (int i = 0; i < n; ++i)
+            if (edge.region.contains(rest[i])) held_.emplace_back(i, edge.value);
+}
+
+void Diffusion::addSpot(const DiffusionSpot& spot, std::span<const Eigen::Vector3d> rest) {
+    Spot s{spot.start, spot.start + spot.duration, spot.rate, {}};
+    for (int i = 0; i < int(rest.size()); ++i)
+        if ((rest[i].head<2>() - spot.center).norm() <= spot.radius) s.particles.push_back(i);
+    if (!s.particles.empty()) spots_.push_back(std::move(s));
+}
+
+void Diffusion::expandScatter(const SpotScatter& scatter, std::span<const Eigen::Vector3d> rest) {
+    // A spot centred on a random particle is uniform over the sheet, whatever its outline.
+    for (int k = 0; k < scatter.count; ++k) {
+        const double u = uniformFromHash(scatter.seed, 2 * std::uint64_t(k));
+        const double v = uniformFromHash(scatter.seed, 2 * std::uint64_t(k) + 1);
+        const int particle = std::min(int(u * double(rest.size())), int(rest.size()) - 1);
+        DiffusionSpot spot;
+        spot.center = rest[particle].head<2>();
+        spot.radius = scatter.radius;
+        spot.rate = scatter.rate;
+        spot.start = scatter.start + v * scatter.spread;
+        spot.duration = scatter.duration;
+        addSpot(spot, rest);
+    }
+}
+
+std::vector<double> Diffusion::initialTheta() const {
+    std::vector<double> theta(particles_, initial_);
+    for (const auto& [i, value] : held_) theta[i] = value;
+    return theta;
+}
+
+void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt) {
+    const int n = int(theta.size());
+    scratch_.resize(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        double flux = 0.0;
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+            if (bonds.alive[b]) flux += rate_[b] * (theta[bonds.partners[b]] - theta[i]);
+        scratch_[i] = theta[i] + dt * flux;
+    }
+    theta.swap(scratch_);
+    for (const Spot& spot : spots_)  // serial, in a fixed order: identical for any thread count
+        if (t >= spot.start && t < spot.end)
+            for (int i : spot.particles) theta[i] += dt * spot.rate;
+    for (const auto& [i, value] : held_) theta[i] = value;
+}
+
+void Diffusion::advance(std::vector<double>& theta, const BondFamilies& bonds, double t,
+                        double dt) {
+    // 0.9 of the Gershgorin bound keeps a margin for rounding.
+    const int substeps = std::max(1, int(std::ceil(dt / (0.9 * stableDt_))));
+    const double h = dt / substeps;
+    for (int k = 0; k < substeps; ++k) step(theta, bonds, t + k * h, h);
+}
+
+}  // namespace rend::sim

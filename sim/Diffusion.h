@@ -1,0 +1,64 @@
+#pragma once
+// Peridynamic diffusion of the membrane paper (eq. 25, after Bobaru & Duangpanya 2010) over the
+// same bonds as the mechanics; a broken bond carries nothing. Boundaries are insulated: no flux
+// leaves a particle's family.
+//
+// Dimensionally consistent form: rho C V_i dtheta_i/dt = K sum_j W0 V_i V_j (theta_j -
+// theta_i)/|xi|^2
+// + sources. Expanding theta_j - theta_i to second order on an isotropic lattice gives
+// K/4 * sum_j W0 V_j * laplacian(theta), so K = 4k / sum_j W0 V_j (interior particle) makes the
+// interior reproduce Fourier's rho C dtheta/dt = k laplacian(theta) (eq. 8). Every pair flux is
+// antisymmetric, so the insulated total sum_i V_i theta_i is conserved.
+//
+// Forward Euler is stable for dt <= min_i rho C / (K sum_j W0 V_j / |xi|^2) (Gershgorin); the
+// mechanics' step is split into as many diffusion sub-steps as that bound needs.
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "sim/Bonds.h"
+#include "sim/Params.h"
+
+namespace rend::sim {
+
+class Diffusion {
+public:
+    Diffusion(const MembraneParams& params, std::span<const Eigen::Vector3d> rest,
+              const BondFamilies& bonds, std::span<const double> volumes);
+
+    /// Whether the scene has anything to diffuse: sources, edges or a non-zero initial value.
+    /// When not, theta stays 0 whatever the conductivity, and the membrane keeps no theta.
+    static bool needed(const MembraneParams& params);
+
+    double stableTimeStep() const { return stableDt_; }
+    double coefficient() const { return K_; }  ///< calibrated K of eq. 25
+
+    /// theta at t = 0 (initial value, edges applied).
+    std::vector<double> initialTheta() const;
+
+    /// Advances theta from t to t + dt, sub-stepping as the stability bound requires.
+    void advance(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt);
+
+    std::size_t spotCount() const { return spots_.size(); }
+
+private:
+    struct Spot {
+        double start, end, rate;
+        std::vector<int> particles;
+    };
+    void addSpot(const DiffusionSpot& spot, std::span<const Eigen::Vector3d> rest);
+    void expandScatter(const SpotScatter& scatter, std::span<const Eigen::Vector3d> rest);
+    void step(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt);
+
+    double K_ = 0.0;
+    double stableDt_ = 0.0;
+    double initial_ = 0.0;
+    int particles_ = 0;
+    std::vector<double> rate_;  ///< per bond: K W0 V_j / (rho C |xi|^2) [1/s]
+    std::vector<Spot> spots_;
+    std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value
+    std::vector<double> scratch_;
+};
+
+}  // namespace rend::sim

@@ -24,7 +24,7 @@ StatsWriter::StatsWriter(const std::filesystem::path& path) : path_(path) {
     partial += ".partial";
     file_ = std::fopen(partial.c_str(), "w");
     if (!file_) throw std::runtime_error("cannot write " + partial.string());
-    std::fputs("frame,time,kinetic_energy,strain_energy,max_speed,broken_bonds\n", file_);
+    std::fputs("frame,time,kinetic_energy,strain_energy,max_speed,max_theta,broken_bonds\n", file_);
 }
 
 StatsWriter::~StatsWriter() {
@@ -32,8 +32,8 @@ StatsWriter::~StatsWriter() {
 }
 
 void StatsWriter::append(const Row& r) {
-    std::fprintf(file_, "%d,%.9g,%.9g,%.9g,%.9g,%zu\n", r.frame, r.time, r.kineticEnergy,
-                 r.strainEnergy, r.maxSpeed, r.brokenBonds);
+    std::fprintf(file_, "%d,%.9g,%.9g,%.9g,%.9g,%.9g,%zu\n", r.frame, r.time, r.kineticEnergy,
+                 r.strainEnergy, r.maxSpeed, r.maxTheta, r.brokenBonds);
     std::fflush(file_);
 }
 

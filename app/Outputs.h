@@ -21,7 +21,7 @@ public:
 
     struct Row {
         int frame;
-        double time, kineticEnergy, strainEnergy, maxSpeed;
+        double time, kineticEnergy, strainEnergy, maxSpeed, maxTheta;
         std::size_t brokenBonds;
     };
     void append(const Row& row);

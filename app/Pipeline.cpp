@@ -190,9 +190,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             s.seconds.simulate += secondsSince(t0);
             s.framesSimulated = frame;
             stats.append({frame, membrane.time(), membrane.kineticEnergy(), membrane.strainEnergy(),
-                          membrane.maxSpeed(), membrane.brokenBondCount()});
+                          membrane.maxSpeed(), membrane.maxTheta(), membrane.brokenBondCount()});
             std::string wrote;
             if (frame >= first && renderer != RendererKind::None) {
+                membrane.updateDamage();
                 wrote = writer.write(membrane.view(frame), s.seconds);
                 ++s.framesWritten;
             }

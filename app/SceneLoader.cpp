@@ -29,7 +29,7 @@ constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 enum class Edge { Left, Right, Bottom, Top };
 constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
 constexpr std::string_view kRenderers[] = {"osmesa", "none"};
-constexpr std::string_view kColorModes[] = {"none", "speed", "strain"};
+constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
 
 /// Above this the lattice alone needs gigabytes and a frame takes minutes.
 constexpr double kMaxParticles = 5e6;
@@ -156,10 +156,98 @@ sim::SheetParams readSheet(const TableReader& root) {
 
 // ---- [material] ------------------------------------------------------------------------------
 
+constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
+constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper"};
+
+/// A key that only matters once another key is chosen ("switch") is an error when that switch
+/// is absent altogether: otherwise a forgotten law = "power_law" silently gives a linear sheet.
+/// A switch that is present but names something else is accepted (the key is then unused), so
+/// a preset's law can be switched with --set material.law=... without editing the preset.
+void requireSwitch(const TableReader& t, std::string_view key, std::string_view switchKey,
+                   std::string_view needed, std::string_view fix) {
+    if (t.has(switchKey)) return;
+    if (const toml::node* node = t.find(key)) {
+        t.fail(key,
+               "no " + std::string(key) + " without " + std::string(switchKey) + " (" +
+                   std::string(needed) + ")",
+               scene::describeType(*node), fix);
+    }
+}
+
+/// Bond law of eqs. 18-20 and its constants.
+void readBondLaw(const TableReader& t, sim::MaterialParams& m) {
+    constexpr Param kLaw{"law", "the bond law: eq. 18, 19 or 20 of the membrane paper",
+                         "\"linear\""};
+    constexpr Param kPowerRatio{"power_ratio", "c*/c of the power law, eq. 19", "-0.1"};
+    constexpr Param kPowerExponent{"power_exponent", "the exponent n of the power law, eq. 19",
+                                   "4"};
+    // Table 1 lists eta0 for every material; only the elastoplastic law (eqs. 20, 27) uses it.
+    constexpr Param kYieldStrain{"yield_strain", "the elastic limit eta0 of eqs. 20 and 27",
+                                 "1e-4"};
+    constexpr Param kSoftening{"softening", "beta of eqs. 20 and 27, the post-yield decay", "1.0"};
+
+    requireSwitch(t, kPowerRatio.key, kLaw.key, "it belongs to law = \"power_law\"",
+                  "Add law = \"power_law\", or remove power_ratio.");
+    requireSwitch(t, kPowerExponent.key, kLaw.key, "it belongs to law = \"power_law\"",
+                  "Add law = \"power_law\", or remove power_exponent.");
+    requireSwitch(t, kSoftening.key, kLaw.key, "it belongs to law = \"elastoplastic\"",
+                  "Add law = \"elastoplastic\", or remove softening.");
+    m.law = sim::BondLawKind(t.choice(kLaw, kLaws).value_or(std::size_t(m.law)));
+    m.powerLawRatio = t.number(kPowerRatio, Range::atMost(0.0)).value_or(m.powerLawRatio);
+    m.powerLawExponent = t.number(kPowerExponent, Range::above(1.0)).value_or(m.powerLawExponent);
+    m.yieldStrain = t.number(kYieldStrain, Range::positive()).value_or(m.yieldStrain);
+    m.softening = t.number(kSoftening, Range::positive()).value_or(m.softening);
+}
+
+/// fracture_energy is a number, or "none" for an unbreakable sheet (the default), so that a
+/// preset's fracture can be switched off with --set material.fracture_energy=none.
+void readFracture(const TableReader& t, sim::MaterialParams& m) {
+    constexpr Param kFractureEnergy{"fracture_energy", "the fracture energy G_f in J/m^2", "11.3"};
+    constexpr Param kCriticalStretch{"critical_stretch",
+                                     "how the critical stretch follows from G_f", "\"calibrated\""};
+    constexpr Param kStrengthLoss{
+        "strength_loss", "the critical stretch lost per unit theta (acid, moisture)", "0.6"};
+    requireSwitch(t, kCriticalStretch.key, kFractureEnergy.key, "bonds never break without it",
+                  "Add e.g. fracture_energy = 11.3, or remove critical_stretch.");
+    requireSwitch(t, kStrengthLoss.key, kFractureEnergy.key, "bonds never break without it",
+                  "Add e.g. fracture_energy = 11.3, or remove strength_loss.");
+    if (const toml::node* node = t.find(kFractureEnergy.key)) {
+        if (const auto* text = node->as_string(); text && text->get() == "none") {
+            m.fractureEnergy.reset();
+        } else if (node->is_number()) {
+            m.fractureEnergy = t.number(kFractureEnergy, Range::positive());
+        } else {
+            t.fail(kFractureEnergy.key,
+                   "a number > 0 (the fracture energy G_f in J/m^2) or \"none\" (unbreakable)",
+                   scene::describeType(*node),
+                   "Use e.g. fracture_energy = 11.3 or fracture_energy = \"none\".");
+        }
+    }
+    m.criticalStretch = sim::CriticalStretchMode(
+        t.choice(kCriticalStretch, kCriticalStretches).value_or(std::size_t(m.criticalStretch)));
+    m.strengthLoss = t.number(kStrengthLoss, Range::nonNegative()).value_or(m.strengthLoss);
+}
+
+/// The diffusive quantity theta inside the material (eq. 25) and what it does to it.
+void readDiffusivity(const TableReader& t, sim::MaterialParams& m) {
+    constexpr Param kCapacity{"capacity", "the diffusive capacity C of eq. 25", "1.0"};
+    constexpr Param kConductivity{"conductivity", "the coefficient of diffusion k of eq. 25",
+                                  "0.01"};
+    constexpr Param kExpansion{"expansion", "alpha, the strain per unit theta", "0.3"};
+    constexpr Param kStiffnessLoss{"stiffness_loss", "the stiffness lost per unit theta", "0.5"};
+    m.capacity = t.number(kCapacity, Range::positive()).value_or(m.capacity);
+    m.conductivity = t.number(kConductivity, Range::nonNegative()).value_or(m.conductivity);
+    m.expansion = t.number(kExpansion, Range::any()).value_or(m.expansion);
+    m.stiffnessLoss = t.number(kStiffnessLoss, Range::nonNegative()).value_or(m.stiffnessLoss);
+}
+
 sim::MaterialParams readMaterial(const TableReader& root) {
     constexpr Param kMaterial{"material", "the membrane's material", ""};
     const TableReader t = root.section(
-        kMaterial, "[material]", {"preset", "name", "E", "poisson", "density", "micromodulus"},
+        kMaterial, "[material]",
+        {"preset", "name", "E", "poisson", "density", "micromodulus", "law", "power_ratio",
+         "power_exponent", "yield_strain", "softening", "fracture_energy", "critical_stretch",
+         "capacity", "conductivity", "expansion", "stiffness_loss", "strength_loss"},
         sectionFix("material"));
     constexpr Param kPreset{"preset", "a file name under assets/materials without .toml",
                             "\"stretch_sheet\""};
@@ -178,6 +266,9 @@ sim::MaterialParams readMaterial(const TableReader& root) {
     m.density = t.requiredNumber(kDensity, Range::positive());
     m.micromodulus = sim::MicromodulusMode(
         t.choice(kMicromodulus, kMicromoduli).value_or(std::size_t(m.micromodulus)));
+    readBondLaw(t, m);
+    readFracture(t, m);
+    readDiffusivity(t, m);
     return m;
 }
 
@@ -284,24 +375,162 @@ sim::BoundaryCondition readBoundary(const toml::table& table, std::size_t index,
     return bc;
 }
 
-std::vector<sim::BoundaryCondition> readBoundaries(const TableReader& root,
-                                                   const sim::SheetParams& sheet) {
-    const toml::node* node = root.find("boundary");
+/// The tables of an array of tables such as [[boundary]]; absent reads as none.
+std::vector<const toml::table*> tablesOf(const TableReader& parent, std::string_view key,
+                                         std::string_view header) {
+    const toml::node* node = parent.find(key);
     if (!node) return {};
-    constexpr std::string_view kExpected = "an array of tables written as [[boundary]]";
-    constexpr std::string_view kFix = "Give each condition its own [[boundary]] header.";
+    const std::string expected = "an array of tables written as [[" + std::string(header) + "]]";
+    const std::string fix = "Give each entry its own [[" + std::string(header) + "]] header.";
     const toml::array* array = node->as_array();
-    if (!array) root.fail("boundary", kExpected, scene::describeType(*node), kFix);
-    std::vector<sim::BoundaryCondition> conditions;
+    if (!array) parent.fail(key, expected, scene::describeType(*node), fix);
+    std::vector<const toml::table*> tables;
     for (const toml::node& item : *array) {
         const toml::table* table = item.as_table();
         if (!table) {
-            root.fail("boundary", kExpected, "an array containing " + scene::describeType(item),
-                      kFix);
+            parent.fail(key, expected, "an array containing " + scene::describeType(item), fix);
         }
+        tables.push_back(table);
+    }
+    return tables;
+}
+
+std::vector<sim::BoundaryCondition> readBoundaries(const TableReader& root,
+                                                   const sim::SheetParams& sheet) {
+    std::vector<sim::BoundaryCondition> conditions;
+    for (const toml::table* table : tablesOf(root, "boundary", "boundary")) {
         conditions.push_back(readBoundary(*table, conditions.size(), sheet));
     }
     return conditions;
+}
+
+// ---- [[notch]] -------------------------------------------------------------------------------
+
+sim::Notch readNotch(const toml::table& table, std::size_t index) {
+    const TableReader t(table, "notch." + std::to_string(index),
+                        "[[notch]] entry " + std::to_string(index), {"points"});
+    constexpr Param kPoints{"points", "the notch polyline in rest coordinates, metres",
+                            "[[-1.0, 0.0], [-0.6, 0.0]]"};
+    if (!t.has(kPoints.key)) t.missing(kPoints, "at least 2 points");
+    sim::Notch notch;
+    notch.points = *t.points(kPoints, 2);
+    for (std::size_t i = 1; i < notch.points.size(); ++i) {
+        if (notch.points[i] == notch.points[i - 1]) {
+            const Eigen::Vector2d& p = notch.points[i];
+            t.fail(kPoints.key,
+                   "consecutive points that differ (" + std::string(kPoints.meaning) + ")",
+                   "point " + std::to_string(i) + " repeating [" + formatNumber(p.x()) + ", " +
+                       formatNumber(p.y()) + "]",
+                   "Remove the repeated point.");
+        }
+    }
+    return notch;
+}
+
+std::vector<sim::Notch> readNotches(const TableReader& root) {
+    std::vector<sim::Notch> notches;
+    for (const toml::table* table : tablesOf(root, "notch", "notch")) {
+        notches.push_back(readNotch(*table, notches.size()));
+    }
+    return notches;
+}
+
+// ---- [diffusion] -----------------------------------------------------------------------------
+
+constexpr Param kSourceRadius{"radius", "the source's radius in metres", "0.05"};
+constexpr Param kSourceRate{"rate", "theta added per second inside it (negative: a sink)", "1.0"};
+constexpr Param kSourceStart{"start", "the time in seconds it switches on", "0.0"};
+constexpr Param kSourceDuration{"duration", "how many seconds it stays on (default: forever)",
+                                "2.0"};
+
+/// A spot whose disc misses the sheet's rest bounding box would silently do nothing.
+void checkSpotReachesSheet(const TableReader& t, const Param& kCenter, const sim::DiffusionSpot& s,
+                           const sim::SheetParams& sheet) {
+    const SheetExtent e = extentOf(sheet);
+    const Eigen::Vector2d nearest = s.center.cwiseMax(e.min).cwiseMin(e.max);
+    const double distance = (s.center - nearest).norm();
+    if (distance <= s.radius) return;
+    t.fail(kCenter.key,
+           "a centre within radius = " + formatNumber(s.radius) +
+               " m of the sheet, whose rest extent is x in [" + formatNumber(e.min.x()) + ", " +
+               formatNumber(e.max.x()) + "], y in [" + formatNumber(e.min.y()) + ", " +
+               formatNumber(e.max.y()) + "]",
+           "[" + formatNumber(s.center.x()) + ", " + formatNumber(s.center.y()) + "], " +
+               formatNumber(distance) + " m away",
+           "Move the spot onto the sheet or enlarge its radius.");
+}
+
+sim::DiffusionSpot readSpot(const toml::table& table, std::size_t index,
+                            const sim::SheetParams& sheet) {
+    const TableReader t(table, "diffusion.spot." + std::to_string(index),
+                        "[[diffusion.spot]] entry " + std::to_string(index),
+                        {"center", "radius", "rate", "start", "duration"});
+    constexpr Param kCenter{"center", "the spot's centre [x, y] in rest coordinates, metres",
+                            "[0.0, 0.0]"};
+    sim::DiffusionSpot s;
+    if (!t.has(kCenter.key)) t.missing(kCenter, "2 numbers");
+    s.center = *t.vec2(kCenter);
+    s.radius = t.requiredNumber(kSourceRadius, Range::positive());
+    s.rate = t.requiredNumber(kSourceRate, Range::any());
+    s.start = t.number(kSourceStart, Range::nonNegative()).value_or(s.start);
+    s.duration = t.number(kSourceDuration, Range::positive()).value_or(s.duration);
+    checkSpotReachesSheet(t, kCenter, s, sheet);
+    return s;
+}
+
+/// Each scatter expands to `count` spots; the cap keeps set-up and the per-step source loop sane.
+constexpr double kMaxScatterCount = 1e4;
+
+sim::SpotScatter readScatter(const toml::table& table, std::size_t index) {
+    const TableReader t(table, "diffusion.scatter." + std::to_string(index),
+                        "[[diffusion.scatter]] entry " + std::to_string(index),
+                        {"count", "radius", "rate", "start", "spread", "duration", "seed"});
+    constexpr Param kCount{"count", "how many spots or droplets", "20"};
+    constexpr Param kSpread{"spread",
+                            "seconds over which droplets are emitted; 0: all spots at once", "3.0"};
+    constexpr Param kSeed{"seed", "the placement's random seed", "1"};
+    const Range countRange = Range::closed(1, kMaxScatterCount);
+    sim::SpotScatter s;
+    if (!t.has(kCount.key)) t.missing(kCount, "an integer " + countRange.describe());
+    s.count = int(*t.integer(kCount, countRange));
+    s.radius = t.requiredNumber(kSourceRadius, Range::positive());
+    s.rate = t.requiredNumber(kSourceRate, Range::any());
+    s.start = t.number(kSourceStart, Range::nonNegative()).value_or(s.start);
+    s.spread = t.number(kSpread, Range::nonNegative()).value_or(s.spread);
+    s.duration = t.number(kSourceDuration, Range::positive()).value_or(s.duration);
+    s.seed = std::uint64_t(t.integer(kSeed, Range::nonNegative()).value_or(s.seed));
+    return s;
+}
+
+sim::DiffusionEdge readDiffusionEdge(const toml::table& table, std::size_t index,
+                                     const sim::SheetParams& sheet) {
+    const TableReader t(table, "diffusion.edge." + std::to_string(index),
+                        "[[diffusion.edge]] entry " + std::to_string(index),
+                        {"edge", "depth", "box", "value"});
+    constexpr Param kValue{"value", "the theta held on the region", "1.0"};
+    sim::DiffusionEdge e;
+    e.region = readRegion(t, sheet);
+    e.value = t.requiredNumber(kValue, Range::any());
+    return e;
+}
+
+sim::DiffusionParams readDiffusion(const TableReader& root, const sim::SheetParams& sheet) {
+    const TableReader t = root.section(
+        {"diffusion", "the diffusive quantity theta (acid, heat, moisture)", ""}, "[diffusion]",
+        {"initial", "spot", "scatter", "edge"}, sectionFix("diffusion"));
+    constexpr Param kInitial{"initial", "theta everywhere at t = 0", "0.0"};
+    sim::DiffusionParams d;
+    d.initial = t.number(kInitial, Range::any()).value_or(d.initial);
+    for (const toml::table* table : tablesOf(t, "spot", "diffusion.spot")) {
+        d.spots.push_back(readSpot(*table, d.spots.size(), sheet));
+    }
+    for (const toml::table* table : tablesOf(t, "scatter", "diffusion.scatter")) {
+        d.scatters.push_back(readScatter(*table, d.scatters.size()));
+    }
+    for (const toml::table* table : tablesOf(t, "edge", "diffusion.edge")) {
+        d.edges.push_back(readDiffusionEdge(*table, d.edges.size(), sheet));
+    }
+    return d;
 }
 
 // ---- [forces], [time] ------------------------------------------------------------------------
@@ -495,14 +724,16 @@ std::filesystem::path assetsDirectory() {
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     const toml::table document = scene::buildSceneDocument(file, overrides, assetsDirectory());
-    const TableReader root(
-        document, "", "the top-level table",
-        {"sheet", "material", "boundary", "forces", "time", "camera", "light", "render", "output"});
+    const TableReader root(document, "", "the top-level table",
+                           {"sheet", "material", "boundary", "notch", "diffusion", "forces", "time",
+                            "camera", "light", "render", "output"});
     Scene s;
     s.file = file;
     s.sim.sheet = readSheet(root);
     s.sim.material = readMaterial(root);
     s.sim.boundaries = readBoundaries(root, s.sim.sheet);
+    s.sim.notches = readNotches(root);
+    s.sim.diffusion = readDiffusion(root, s.sim.sheet);
     readForces(root, s.sim);
     s.dtLocation = readTime(root, s.sim.time);
     s.render.camera = readCamera(root, s.sim.sheet);

@@ -343,6 +343,46 @@ std::optional<Eigen::Vector3d> TableReader::vec3(const Param& p, Range element,
     return Eigen::Vector3d((*v)[0], (*v)[1], (*v)[2]);
 }
 
+std::optional<std::vector<Eigen::Vector2d>> TableReader::points(const Param& p,
+                                                                std::size_t minCount,
+                                                                Range element) const {
+    const toml::node* node = find(p.key);
+    if (!node) return std::nullopt;
+    const std::string expected = withMeaning(
+        "an array of at least " + std::to_string(minCount) + " points [x, y]", p.meaning);
+    const toml::array* array = node->as_array();
+    if (!array || array->size() < minCount) {
+        fail(p.key, expected, describeType(*node), useInstead(p));
+    }
+    std::string pointExpected = "a point [x, y] of 2 numbers";
+    if (const std::string bounds = element.describe(); !bounds.empty()) {
+        pointExpected += " " + bounds;
+    }
+    pointExpected = withMeaning(pointExpected, p.meaning);
+
+    std::vector<Eigen::Vector2d> result;
+    for (const toml::node& item : *array) {
+        const std::string itemKey = keyPath(p.key) + "." + std::to_string(result.size());
+        const auto failItem = [&](const std::string& found) {
+            throw SceneError(formatError(locationOf(item.source()), itemKey, pointExpected, found,
+                                         useInstead(p)));
+        };
+        const toml::array* point = item.as_array();
+        if (!point || point->size() != 2) failItem(describeType(item));
+        std::vector<double> values;
+        for (const toml::node& coordinate : *point) {
+            const std::optional<double> v = asNumber(coordinate);
+            if (!v) failItem("an array containing " + describeType(coordinate));
+            values.push_back(*v);
+        }
+        for (const double v : values) {
+            if (!std::isfinite(v) || !element.contains(v)) failItem(formatNumbers(values));
+        }
+        result.emplace_back(values[0], values[1]);
+    }
+    return result;
+}
+
 std::optional<TableReader> TableReader::subtable(const Param& p, std::string title,
                                                  std::initializer_list<std::string_view> allowed,
                                                  std::string_view fix) const {

@@ -58,6 +58,8 @@ struct Range {
     static Range closed(double lo, double hi) { return {lo, hi, false, false}; }
     static Range open(double lo, double hi) { return {lo, hi, true, true}; }
     static Range openClosed(double lo, double hi) { return {lo, hi, true, false}; }
+    static Range above(double lo) { return {lo, Range{}.hi, true, false}; }
+    static Range atMost(double hi) { return {Range{}.lo, hi, false, false}; }
 
     bool contains(double v) const;
     std::string describe() const;  ///< empty when unbounded
@@ -96,6 +98,10 @@ public:
     std::optional<Eigen::Vector2d> vec2(const Param& p, Range element = Range::any()) const;
     std::optional<Eigen::Vector3d> vec3(const Param& p, Range element = Range::any(),
                                         bool nonZero = false) const;
+    /// An array of at least `minCount` points [x, y]; a malformed point is reported at its own
+    /// location, keyed KEY.INDEX (counting from 0, like --set).
+    std::optional<std::vector<Eigen::Vector2d>> points(const Param& p, std::size_t minCount,
+                                                       Range element = Range::any()) const;
     /// A nested table (inline or not) with its own allowed keys; `fix` is the advice when the
     /// value is not a table.
     std::optional<TableReader> subtable(const Param& p, std::string title,

@@ -253,8 +253,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"bad_unknown_key.toml",
                  "6:2",
                  {"unknown key 'materal' in the top-level table; expected one of: sheet, material, "
-                  "boundary, forces, time, camera, light, render, output. Did you mean "
-                  "'material'?"}},
+                  "boundary, notch, diffusion, forces, time, camera, light, render, output. Did "
+                  "you mean 'material'?"}},
         BadScene{"bad_sub_key.toml",
                  "13:1",
                  {"unknown key 'velocty' in [[boundary]] entry 0", "Did you mean 'velocity'?"}},
@@ -293,7 +293,45 @@ INSTANTIATE_TEST_SUITE_P(
                  {"boundary.1.velocity: expected no velocity for type = \"pinned\""}},
         BadScene{"bad_too_many_particles.toml",
                  "4:6",
-                 {"sheet.dx: expected a spacing of at least 0.0045 m", "at most 5e6 particles"}}));
+                 {"sheet.dx: expected a spacing of at least 0.0045 m", "at most 5e6 particles"}},
+        BadScene{"bad_law.toml",
+                 "9:7",
+                 {"material.law: expected one of \"linear\", \"power_law\", \"elastoplastic\", "
+                  "found \"power-law\". Did you mean \"power_law\"?"}},
+        BadScene{"bad_law_constant_without_law.toml",
+                 "9:15",
+                 {"material.power_ratio: expected no power_ratio without law (it belongs to law = "
+                  "\"power_law\"), found the number -0.1. Add law = \"power_law\", or remove "
+                  "power_ratio."}},
+        BadScene{"bad_fracture_energy.toml",
+                 "9:19",
+                 {"material.fracture_energy: expected a number > 0 (the fracture energy G_f in "
+                  "J/m^2), found -11.3. Use e.g. fracture_energy = 11.3."}},
+        BadScene{"bad_notch_one_point.toml",
+                 "14:10",
+                 {"notch.1.points: expected an array of at least 2 points [x, y] (the notch "
+                  "polyline in rest coordinates, metres), found an array of 1 element. Use e.g. "
+                  "points = [[-1.0, 0.0], [-0.6, 0.0]]."}},
+        BadScene{"bad_notch_point_3d.toml",
+                 "11:24",
+                 {"notch.0.points.1: expected a point [x, y] of 2 numbers",
+                  "found an array of 3 "
+                  "elements"}},
+        BadScene{"bad_scatter_count.toml",
+                 "15:9",
+                 {"diffusion.scatter.0.count: expected an integer in [1, 10000] (how many spots "
+                  "or droplets), found 2.5. Use e.g. count = 20."}},
+        BadScene{"bad_spot_missing_radius.toml",
+                 "10:1",
+                 {"diffusion.spot.0.radius is missing: expected the source's radius in metres (> "
+                  "0). Add e.g. radius = 0.05 under [[diffusion.spot]] entry 0."}},
+        BadScene{"bad_spot_off_sheet.toml",
+                 "11:20",
+                 {"diffusion.spot.0.center: expected a centre within radius = 0.5 m of the sheet",
+                  "found [2, 0], 1.5 m away"}},
+        BadScene{"bad_diffusion_edge.toml",
+                 "16:7",
+                 {"diffusion.edge.1.box: expected either edge or box, not both"}}));
 
 TEST_F(SceneTest, MissingFileIsReportedWithItsPath) {
     const fs::path file = kScenes / "no_such_scene.toml";
@@ -318,6 +356,15 @@ TEST_F(SceneTest, SpacingMustLeaveAtLeastFourParticlesAcross) {
 }
 
 // ---- --set -----------------------------------------------------------------------------------
+
+TEST_F(SceneTest, ColorByThetaAndDamage) {
+    EXPECT_EQ(loadScene(kStretch, {"render.color_by=theta"}).render.colorBy,
+              render::ColorBy::Theta);
+    EXPECT_EQ(loadScene(kStretch, {"render.color_by=damage"}).render.colorBy,
+              render::ColorBy::Damage);
+    EXPECT_NE(errorOf(kStretch, {"render.color_by=damag"}).find("Did you mean \"damage\"?"),
+              std::string::npos);
+}
 
 TEST_F(SceneTest, SetOverridesValues) {
     const Scene s = loadScene(kStretch, {"material.E=3e4", "camera.fov=55", "sheet.lattice=square",
@@ -435,4 +482,379 @@ TEST_F(SceneTest, UnknownPresetViaSetListsTheAvailableOnes) {
                            "), found \"rubber\"."),
               std::string::npos)
         << message;
+}
+
+// ---- bond laws, fracture, diffusivity ----------------------------------------------------------
+
+TEST_F(SceneTest, MaterialDefaultsAreLinearUnbreakableAndInert) {
+    const sim::MaterialParams m = loadScene(writeScene("minimal.toml", kMinimal)).sim.material;
+    EXPECT_EQ(m.law, sim::BondLawKind::Linear);
+    EXPECT_DOUBLE_EQ(m.powerLawRatio, 0.0);
+    EXPECT_DOUBLE_EQ(m.powerLawExponent, 4.0);
+    EXPECT_DOUBLE_EQ(m.yieldStrain, 1e-4);
+    EXPECT_DOUBLE_EQ(m.softening, 1.0);
+    EXPECT_FALSE(m.fractureEnergy.has_value());
+    EXPECT_EQ(m.criticalStretch, sim::CriticalStretchMode::Calibrated);
+    EXPECT_DOUBLE_EQ(m.capacity, 1.0);
+    EXPECT_DOUBLE_EQ(m.conductivity, 0.0);
+    EXPECT_DOUBLE_EQ(m.expansion, 0.0);
+    EXPECT_DOUBLE_EQ(m.stiffnessLoss, 0.0);
+    EXPECT_DOUBLE_EQ(m.strengthLoss, 0.0);
+}
+
+TEST_F(SceneTest, MaterialReadsEveryNewKey) {
+    const sim::MaterialParams m = loadScene(writeScene("material.toml", std::string(kMinimal) + R"(
+law = "elastoplastic"
+yield_strain = 2e-3
+softening = 2.5
+fracture_energy = 4.0
+critical_stretch = "paper"
+capacity = 2.0
+conductivity = 0.3
+expansion = -0.5
+stiffness_loss = 0.25
+strength_loss = 1.5
+)"))
+                                      .sim.material;
+    EXPECT_EQ(m.law, sim::BondLawKind::Elastoplastic);
+    EXPECT_DOUBLE_EQ(m.yieldStrain, 2e-3);
+    EXPECT_DOUBLE_EQ(m.softening, 2.5);
+    ASSERT_TRUE(m.fractureEnergy.has_value());
+    EXPECT_DOUBLE_EQ(*m.fractureEnergy, 4.0);
+    EXPECT_EQ(m.criticalStretch, sim::CriticalStretchMode::Paper);
+    EXPECT_DOUBLE_EQ(m.capacity, 2.0);
+    EXPECT_DOUBLE_EQ(m.conductivity, 0.3);
+    EXPECT_DOUBLE_EQ(m.expansion, -0.5) << "alpha may be negative (shrinking)";
+    EXPECT_DOUBLE_EQ(m.stiffnessLoss, 0.25);
+    EXPECT_DOUBLE_EQ(m.strengthLoss, 1.5);
+}
+
+TEST_F(SceneTest, MaterialRangesAreChecked) {
+    const fs::path file = writeScene("minimal.toml", kMinimal);
+    const auto expectError = [&](std::vector<std::string> sets, const std::string& fragment) {
+        const std::string message = errorOf(file, sets);
+        EXPECT_NE(message.find(fragment), std::string::npos) << message;
+    };
+    expectError({"material.law=power_law", "material.power_ratio=0.1"},
+                "material.power_ratio: expected a number <= 0 (c*/c of the power law, eq. 19), "
+                "found 0.1.");
+    expectError({"material.law=power_law", "material.power_exponent=1"},
+                "material.power_exponent: expected a number > 1");
+    expectError({"material.yield_strain=0"}, "material.yield_strain: expected a number > 0");
+    expectError({"material.law=elastoplastic", "material.softening=-1"},
+                "material.softening: expected a number > 0");
+    expectError({"material.capacity=0"}, "material.capacity: expected a number > 0");
+    expectError({"material.conductivity=-0.1"}, "material.conductivity: expected a number >= 0");
+    expectError({"material.stiffness_loss=-1"}, "material.stiffness_loss: expected a number >= 0");
+    expectError({"material.fracture_energy=1", "material.strength_loss=-1"},
+                "material.strength_loss: expected a number >= 0");
+    expectError({"material.fracture_energy=1", "material.critical_stretch=printed"},
+                "material.critical_stretch: expected one of \"calibrated\", \"paper\"");
+    expectError({"material.fracture_energy=true"},
+                "material.fracture_energy: expected a number > 0 (the fracture energy G_f in "
+                "J/m^2) or \"none\" (unbreakable), found a boolean.");
+    expectError({"material.expansion=nan"}, "material.expansion: expected a number");
+}
+
+TEST_F(SceneTest, LawAndFractureConstantsNeedTheirSwitch) {
+    const fs::path file = writeScene("minimal.toml", kMinimal);
+    EXPECT_NE(errorOf(file, {"material.softening=2"})
+                  .find("material.softening: expected no softening without law (it belongs to "
+                        "law = \"elastoplastic\")"),
+              std::string::npos);
+    EXPECT_NE(
+        errorOf(file, {"material.power_exponent=3"}).find("expected no power_exponent without law"),
+        std::string::npos);
+    EXPECT_NE(errorOf(file, {"material.critical_stretch=paper"})
+                  .find("material.critical_stretch: expected no critical_stretch without "
+                        "fracture_energy (bonds never break without it)"),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"material.strength_loss=0.5"})
+                  .find("expected no strength_loss without fracture_energy"),
+              std::string::npos);
+    // With the switch present, another law's constants are accepted and unused.
+    const Scene s = loadScene(
+        file, {"material.law=linear", "material.power_ratio=-0.2", "material.softening=3"});
+    EXPECT_EQ(s.sim.material.law, sim::BondLawKind::Linear);
+    EXPECT_DOUBLE_EQ(s.sim.material.powerLawRatio, -0.2);
+}
+
+TEST_F(SceneTest, PresetLawAndFractureCanBeSwitchedWithSet) {
+    const fs::path file = writeScene("rubber.toml", R"(
+[sheet]
+size = [1.0, 1.0]
+dx = 0.05
+
+[material]
+preset = "rubber_film"
+)");
+    const Scene s = loadScene(file, {"material.law=linear", "material.fracture_energy=none"});
+    EXPECT_EQ(s.sim.material.law, sim::BondLawKind::Linear);
+    EXPECT_FALSE(s.sim.material.fractureEnergy.has_value());
+    EXPECT_DOUBLE_EQ(s.sim.material.strengthLoss, 0.8) << "kept, unused while unbreakable";
+}
+
+// ---- presets from the membrane paper ---------------------------------------------------------
+
+namespace {
+
+/// A tiny scene that uses preset NAME and nothing else in [material].
+std::string presetScene(const std::string& name) {
+    return "[sheet]\nsize = [1.0, 1.0]\ndx = 0.05\n\n[material]\npreset = \"" + name + "\"\n";
+}
+
+struct Table1Column {
+    const char* preset;
+    double E, poisson, density, capacity, conductivity, expansion, fractureEnergy, yieldStrain;
+    sim::BondLawKind law;
+};
+
+}  // namespace
+
+TEST_F(SceneTest, EveryShippedPresetLoads) {
+    int count = 0;
+    for (const auto& entry : fs::directory_iterator(kSource / "assets" / "materials")) {
+        if (entry.path().extension() != ".toml") continue;
+        const std::string name = entry.path().stem().string();
+        const fs::path file = writeScene(name + ".toml", presetScene(name));
+        EXPECT_EQ(errorOf(file), "<no SceneError>") << name;
+        EXPECT_EQ(errorOf(kStretch, {"material.preset=" + name}), "<no SceneError>") << name;
+        if (errorOf(file) == "<no SceneError>") {
+            EXPECT_EQ(loadScene(file).sim.material.name, name);
+        }
+        ++count;
+    }
+    EXPECT_GE(count, 7);
+}
+
+TEST_F(SceneTest, PaperPresetsMatchTable1) {
+    using sim::BondLawKind;
+    // Membrane paper, Table 1: E, nu, rho, C, k, alpha, G_f, eta0 per column.
+    const Table1Column columns[] = {
+        {"crack_path", 2e4, 0.3, 5000, 1, 0.01, 1, 11.3, 1e-4, BondLawKind::Linear},
+        {"foil", 2e3, 0.3, 5000, 1, 0.3, 0.3, 1.2, 1e-4, BondLawKind::Elastoplastic},
+        {"rubber_film", 1e2, 0.3, 100, 1, 1, 10, 11.3, 1e-3, BondLawKind::PowerLaw},
+        {"seaweed", 2e4, 0.3, 100, 1, 0.01, 0.3, 2.4, 1e-4, BondLawKind::Linear},
+    };
+    for (const Table1Column& c : columns) {
+        SCOPED_TRACE(c.preset);
+        const sim::MaterialParams m =
+            loadScene(writeScene(std::string(c.preset) + ".toml", presetScene(c.preset)))
+                .sim.material;
+        EXPECT_EQ(m.name, c.preset);
+        EXPECT_DOUBLE_EQ(m.youngsModulus, c.E);
+        EXPECT_DOUBLE_EQ(m.poissonRatio, c.poisson);
+        EXPECT_DOUBLE_EQ(m.density, c.density);
+        EXPECT_DOUBLE_EQ(m.capacity, c.capacity);
+        EXPECT_DOUBLE_EQ(m.conductivity, c.conductivity);
+        EXPECT_DOUBLE_EQ(m.expansion, c.expansion);
+        ASSERT_TRUE(m.fractureEnergy.has_value());
+        EXPECT_DOUBLE_EQ(*m.fractureEnergy, c.fractureEnergy);
+        EXPECT_DOUBLE_EQ(m.yieldStrain, c.yieldStrain);
+        EXPECT_EQ(m.law, c.law);
+        EXPECT_EQ(m.micromodulus, sim::MicromodulusMode::Calibrated);
+        EXPECT_EQ(m.criticalStretch, sim::CriticalStretchMode::Calibrated);
+    }
+}
+
+TEST_F(SceneTest, PresetsCarryTheirChosenLawsAndLosses) {
+    const auto material = [&](const std::string& name) {
+        return loadScene(writeScene(name + ".toml", presetScene(name))).sim.material;
+    };
+    const sim::MaterialParams rubber = material("rubber_film");
+    EXPECT_DOUBLE_EQ(rubber.powerLawRatio, -0.1);
+    EXPECT_DOUBLE_EQ(rubber.powerLawExponent, 4.0);
+    EXPECT_DOUBLE_EQ(rubber.stiffnessLoss, 0.8);
+    EXPECT_DOUBLE_EQ(rubber.strengthLoss, 0.8);
+    EXPECT_DOUBLE_EQ(material("foil").softening, 1.0);
+    const sim::MaterialParams seaweed = material("seaweed");
+    EXPECT_DOUBLE_EQ(seaweed.stiffnessLoss, 0.5);
+    EXPECT_DOUBLE_EQ(seaweed.strengthLoss, 0.6);
+
+    const sim::MaterialParams dry = material("paper_towel_dry");
+    const sim::MaterialParams wet = material("paper_towel_wet");
+    EXPECT_EQ(dry.law, sim::BondLawKind::Linear);
+    ASSERT_TRUE(dry.fractureEnergy && wet.fractureEnergy);
+    EXPECT_DOUBLE_EQ(*dry.fractureEnergy, 3.0);
+    EXPECT_DOUBLE_EQ(wet.youngsModulus, dry.youngsModulus) << "same base";
+    EXPECT_DOUBLE_EQ(wet.density, dry.density);
+    EXPECT_DOUBLE_EQ(*wet.fractureEnergy, *dry.fractureEnergy);
+    EXPECT_DOUBLE_EQ(dry.conductivity, 0.0);
+    EXPECT_DOUBLE_EQ(dry.stiffnessLoss, 0.0);
+    EXPECT_DOUBLE_EQ(wet.conductivity, 0.05);
+    EXPECT_DOUBLE_EQ(wet.expansion, 0.1);
+    EXPECT_DOUBLE_EQ(wet.stiffnessLoss, 0.5);
+    EXPECT_DOUBLE_EQ(wet.strengthLoss, 0.5);
+}
+
+// ---- [[notch]] and [diffusion] ---------------------------------------------------------------
+
+TEST_F(SceneTest, NotchesAndDiffusionParse) {
+    const Scene s = loadScene(writeScene("acid.toml", std::string(kMinimal) + R"(
+conductivity = 0.01
+
+[[notch]]
+points = [[-0.5, 0.0], [-0.3, 0.0]]
+
+[[notch]]
+points = [[0.1, -0.2], [0.2, 0], [0.3, 0.1]]
+
+[diffusion]
+initial = 0.25
+
+[[diffusion.spot]]
+center = [0.1, -0.1]
+radius = 0.08
+rate = -2.0
+
+[[diffusion.spot]]
+center = [0.0, 0.0]
+radius = 0.05
+rate = 1.5
+start = 0.5
+duration = 2.0
+
+[[diffusion.scatter]]
+count = 12
+radius = 0.03
+rate = 4.0
+start = 1.0
+spread = 3.0
+duration = 0.5
+seed = 9
+
+[[diffusion.scatter]]
+count = 1
+radius = 0.1
+rate = 1.0
+
+[[diffusion.edge]]
+edge = "left"
+depth = 2
+value = 1.0
+
+[[diffusion.edge]]
+box = { min = [0.4, -0.25], max = [0.5, 0.25] }
+value = -0.5
+)"));
+    ASSERT_EQ(s.sim.notches.size(), 2u);
+    ASSERT_EQ(s.sim.notches[0].points.size(), 2u);
+    EXPECT_EQ(s.sim.notches[0].points[0], Eigen::Vector2d(-0.5, 0.0));
+    EXPECT_EQ(s.sim.notches[0].points[1], Eigen::Vector2d(-0.3, 0.0));
+    ASSERT_EQ(s.sim.notches[1].points.size(), 3u);
+    EXPECT_EQ(s.sim.notches[1].points[1], Eigen::Vector2d(0.2, 0.0)) << "integers are numbers";
+
+    const sim::DiffusionParams& d = s.sim.diffusion;
+    EXPECT_DOUBLE_EQ(d.initial, 0.25);
+    ASSERT_EQ(d.spots.size(), 2u);
+    EXPECT_EQ(d.spots[0].center, Eigen::Vector2d(0.1, -0.1));
+    EXPECT_DOUBLE_EQ(d.spots[0].radius, 0.08);
+    EXPECT_DOUBLE_EQ(d.spots[0].rate, -2.0) << "a sink";
+    EXPECT_DOUBLE_EQ(d.spots[0].start, 0.0);
+    EXPECT_TRUE(std::isinf(d.spots[0].duration)) << "forever by default";
+    EXPECT_DOUBLE_EQ(d.spots[1].start, 0.5);
+    EXPECT_DOUBLE_EQ(d.spots[1].duration, 2.0);
+
+    ASSERT_EQ(d.scatters.size(), 2u);
+    const sim::SpotScatter& spray = d.scatters[0];
+    EXPECT_EQ(spray.count, 12);
+    EXPECT_DOUBLE_EQ(spray.radius, 0.03);
+    EXPECT_DOUBLE_EQ(spray.rate, 4.0);
+    EXPECT_DOUBLE_EQ(spray.start, 1.0);
+    EXPECT_DOUBLE_EQ(spray.spread, 3.0);
+    EXPECT_DOUBLE_EQ(spray.duration, 0.5);
+    EXPECT_EQ(spray.seed, 9u);
+    const sim::SpotScatter& heat = d.scatters[1];
+    EXPECT_EQ(heat.count, 1);
+    EXPECT_DOUBLE_EQ(heat.start, 0.0);
+    EXPECT_DOUBLE_EQ(heat.spread, 0.0) << "all at once";
+    EXPECT_TRUE(std::isinf(heat.duration));
+    EXPECT_EQ(heat.seed, 1u);
+
+    ASSERT_EQ(d.edges.size(), 2u);
+    EXPECT_DOUBLE_EQ(d.edges[0].value, 1.0);
+    EXPECT_NEAR(d.edges[0].region.max.x(), -0.5 + 0.1, 1e-9) << "depth 2 * dx, like [[boundary]]";
+    EXPECT_TRUE(std::isinf(d.edges[0].region.min.x()));
+    EXPECT_EQ(d.edges[1].region.min, Eigen::Vector2d(0.4, -0.25));
+    EXPECT_EQ(d.edges[1].region.max, Eigen::Vector2d(0.5, 0.25));
+    EXPECT_DOUBLE_EQ(d.edges[1].value, -0.5);
+}
+
+TEST_F(SceneTest, NoNotchOrDiffusionMeansNone) {
+    const Scene s = loadScene(kStretch);
+    EXPECT_TRUE(s.sim.notches.empty());
+    EXPECT_DOUBLE_EQ(s.sim.diffusion.initial, 0.0);
+    EXPECT_TRUE(s.sim.diffusion.spots.empty());
+    EXPECT_TRUE(s.sim.diffusion.scatters.empty());
+    EXPECT_TRUE(s.sim.diffusion.edges.empty());
+}
+
+TEST_F(SceneTest, DiffusionSourcesNeedNoConductivity) {
+    // Sources then act only where they are; that is a valid (if local) scene.
+    const Scene s = loadScene(writeScene("local.toml", std::string(kMinimal) + R"(
+[[diffusion.spot]]
+center = [0.0, 0.0]
+radius = 0.1
+rate = 1.0
+)"));
+    EXPECT_DOUBLE_EQ(s.sim.material.conductivity, 0.0);
+    EXPECT_EQ(s.sim.diffusion.spots.size(), 1u);
+}
+
+TEST_F(SceneTest, MalformedNotchesAndSourcesAreLocated) {
+    const fs::path file = writeScene("sources.toml", std::string(kMinimal) + R"(
+[[notch]]
+points = [[0.0, 0.0], [0.1, 0.0]]
+
+[[diffusion.scatter]]
+count = 3
+radius = 0.05
+rate = 1.0
+)");
+    const std::string where = file.string() + ":";
+    EXPECT_EQ(errorOf(file, {"diffusion.scatter.0.count=0"}),
+              "--set 'diffusion.scatter.0.count=0': error: diffusion.scatter.0.count: expected "
+              "an integer in [1, 10000] (how many spots or droplets), found 0. Use e.g. count "
+              "= 20.");
+    EXPECT_NE(errorOf(file, {"diffusion.scatter.0.seed=-1"})
+                  .find("diffusion.scatter.0.seed: expected an integer >= 0"),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"diffusion.scatter.0.spread=-1"})
+                  .find("diffusion.scatter.0.spread: expected a number >= 0"),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"diffusion.scatter.0.duration=0"})
+                  .find("diffusion.scatter.0.duration: expected a number > 0"),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"diffusion.scatter.0.rat=1"})
+                  .find("unknown key 'rat' in [[diffusion.scatter]] entry 0"),
+              std::string::npos);
+    EXPECT_EQ(errorOf(file, {"notch.0.points=[[0, 0], [0, 0]]"}),
+              "--set 'notch.0.points=[[0, 0], [0, 0]]': error: notch.0.points: expected "
+              "consecutive points that differ (the notch polyline in rest coordinates, metres), "
+              "found point 1 repeating [0, 0]. Remove the repeated point.");
+    EXPECT_NE(errorOf(file, {"notch.0.points=[[0, 0], [0, \"a\"]]"})
+                  .find("notch.0.points.1: expected a point [x, y] of 2 numbers (the notch "
+                        "polyline in rest coordinates, metres), found an array containing a "
+                        "string \"a\"."),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"notch.0.points=3"})
+                  .find("notch.0.points: expected an array of at least 2 points [x, y]"),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"notch=5"})
+                  .find("notch: expected an array of tables written as [[notch]], found the "
+                        "number 5. Give each entry its own [[notch]] header."),
+              std::string::npos);
+    EXPECT_NE(errorOf(file, {"diffusion.initial=inf"})
+                  .find("diffusion.initial: expected a number (theta everywhere at t = 0), found "
+                        "inf."),
+              std::string::npos);
+    const std::string edge = errorOf(writeScene("edge.toml", std::string(kMinimal) + R"(
+[[diffusion.edge]]
+edge = "right"
+)"));
+    EXPECT_EQ(edge.rfind(where.substr(0, where.rfind('/')) + "/edge.toml:10:1: error: "
+                                                             "diffusion.edge.0.value is missing",
+                         0),
+              0u)
+        << edge;
 }

@@ -85,6 +85,7 @@ public:
 
     std::vector<Eigen::Vector3d>& positions() { return x_; }
     std::vector<Eigen::Vector3d>& velocities() { return v_; }
+    const std::vector<Eigen::Vector3d>& velocities() const { return v_; }
     std::vector<double>& theta() { return theta_; }  ///< empty without diffusion
     const std::vector<double>& theta() const { return theta_; }
     const std::vector<double>& damage() const { return damage_; }

@@ -591,7 +591,7 @@ preset = "rubber_film"
     const Scene s = loadScene(file, {"material.law=linear", "material.fracture_energy=none"});
     EXPECT_EQ(s.sim.material.law, sim::BondLawKind::Linear);
     EXPECT_FALSE(s.sim.material.fractureEnergy.has_value());
-    EXPECT_DOUBLE_EQ(s.sim.material.strengthLoss, 0.8) << "kept, unused while unbreakable";
+    EXPECT_DOUBLE_EQ(s.sim.material.strengthLoss, 15.0) << "kept, unused while unbreakable";
 }
 
 // ---- presets from the membrane paper ---------------------------------------------------------
@@ -662,14 +662,14 @@ TEST_F(SceneTest, PresetsCarryTheirChosenLawsAndLosses) {
         return loadScene(writeScene(name + ".toml", presetScene(name))).sim.material;
     };
     const sim::MaterialParams rubber = material("rubber_film");
-    EXPECT_DOUBLE_EQ(rubber.powerLawRatio, -0.1);
-    EXPECT_DOUBLE_EQ(rubber.powerLawExponent, 4.0);
-    EXPECT_DOUBLE_EQ(rubber.stiffnessLoss, 0.8);
-    EXPECT_DOUBLE_EQ(rubber.strengthLoss, 0.8);
+    EXPECT_DOUBLE_EQ(rubber.powerLawRatio, -0.05);
+    EXPECT_DOUBLE_EQ(rubber.powerLawExponent, 2.0);
+    EXPECT_DOUBLE_EQ(rubber.stiffnessLoss, 15.0);
+    EXPECT_DOUBLE_EQ(rubber.strengthLoss, 15.0);
     EXPECT_DOUBLE_EQ(material("foil").softening, 1.0);
     const sim::MaterialParams seaweed = material("seaweed");
-    EXPECT_DOUBLE_EQ(seaweed.stiffnessLoss, 0.5);
-    EXPECT_DOUBLE_EQ(seaweed.strengthLoss, 0.6);
+    EXPECT_DOUBLE_EQ(seaweed.stiffnessLoss, 3.0);
+    EXPECT_DOUBLE_EQ(seaweed.strengthLoss, 4.0);
 
     const sim::MaterialParams dry = material("paper_towel_dry");
     const sim::MaterialParams wet = material("paper_towel_wet");
@@ -682,7 +682,7 @@ TEST_F(SceneTest, PresetsCarryTheirChosenLawsAndLosses) {
     EXPECT_DOUBLE_EQ(dry.conductivity, 0.0);
     EXPECT_DOUBLE_EQ(dry.stiffnessLoss, 0.0);
     EXPECT_DOUBLE_EQ(wet.conductivity, 0.05);
-    EXPECT_DOUBLE_EQ(wet.expansion, 0.1);
+    EXPECT_DOUBLE_EQ(wet.expansion, 0.05);
     EXPECT_DOUBLE_EQ(wet.stiffnessLoss, 0.5);
     EXPECT_DOUBLE_EQ(wet.strengthLoss, 0.5);
 }

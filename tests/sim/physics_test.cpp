@@ -119,7 +119,9 @@ TEST(Fracture, BondsBreakJustAboveTheCriticalStretchAndNotBelow) {
         stretchAffinely(m, factor * m.criticalStretch());
         m.step();
         EXPECT_EQ(m.brokenBondCount() > 0, factor > 1.0) << factor;
-        if (factor > 1.0) EXPECT_EQ(m.brokenBondCount(), m.bondCount());
+        if (factor > 1.0) {
+            EXPECT_EQ(m.brokenBondCount(), m.bondCount());
+        }
     }
 }
 

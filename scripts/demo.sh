@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh
-scene=${1:-scenes/shear.toml}
+scene=${1:-scenes/foil_tear_heat.toml}
 shift || true
 name=$(basename "$scene" .toml)
 time build/rend run "$scene" --out "out/$name" "$@"

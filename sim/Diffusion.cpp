@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/Parallel.h"
 #include "sim/Random.h"
 
 namespace rend::sim {

@@ -17,6 +17,7 @@
 #include "sim/Diffusion.h"
 #include "sim/FrameView.h"
 #include "sim/Lattice.h"
+#include "sim/Parallel.h"
 #include "sim/Params.h"
 #include "sim/Random.h"
 

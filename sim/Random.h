@@ -13,8 +13,4 @@ inline double uniformFromHash(std::uint64_t seed, std::uint64_t index) {
     return double(z >> 11) * 0x1.0p-53;
 }
 
-/// Below this many particles a loop over particles runs serially: waking the OpenMP team costs
-/// more than it saves. The loop body is the same either way, so results do not change.
-inline constexpr int kParallelThreshold = 2048;
-
 }  // namespace rend::sim

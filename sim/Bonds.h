@@ -3,6 +3,7 @@
 // writes only to i (LAMMPS PERI style): no atomics, identical bits for any thread count.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -21,6 +22,19 @@ struct BondFamilies {
     std::size_t bondCount() const { return partners.size() / 2; }
     int familySize(int i) const { return offsets[i + 1] - offsets[i]; }
 };
+
+/// max over particles i of sum over i's bonds b of term(b): the sum of an interior particle,
+/// whose family is complete. Calibrations match the continuum there.
+template <class Term>
+double interiorFamilySum(const BondFamilies& bonds, Term term) {
+    double best = 0.0;
+    for (int i = 0; i < bonds.particleCount(); ++i) {
+        double sum = 0.0;
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) sum += term(b);
+        best = std::max(best, sum);
+    }
+    return best;
+}
 
 /// Every pair closer than `horizon` in the rest configuration, partners sorted by index.
 BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double horizon);

@@ -19,13 +19,8 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
     : initial_(params.diffusion.initial), particles_(bonds.particleCount()) {
     const MaterialParams& m = params.material;
     const int n = bonds.particleCount();
-    double interior = 0.0;
-    for (int i = 0; i < n; ++i) {
-        double sum = 0.0;
-        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
-            sum += bonds.weight[b] * volumes[bonds.partners[b]];
-        interior = std::max(interior, sum);
-    }
+    const double interior = interiorFamilySum(
+        bonds, [&](int b) { return bonds.weight[b] * volumes[bonds.partners[b]]; });
     K_ = interior > 0.0 ? 4.0 * m.conductivity / interior : 0.0;
     const double rhoC = m.density * m.capacity;
     rate_.resize(bonds.directedCount());

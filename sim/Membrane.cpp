@@ -38,19 +38,15 @@ void Membrane::computeBondScales(const MembraneParams& params) {
     const int n = particleCount();
     const bool paper = params.material.micromodulus == MicromodulusMode::Paper;
     bondScale_.resize(bonds_.directedCount());
-    double interiorWeightedVolume = 0.0;
-    for (int i = 0; i < n; ++i) {
-        double weightedVolume = 0.0;
+    for (int i = 0; i < n; ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             const int j = bonds_.partners[b];
-            const double w = bonds_.weight[b];
-            weightedVolume += w * volume_[j];
             // Literal eq. 22 multiplies by the area A_j; the consistent form by V_i V_j.
             const double measure = paper ? lattice_.particleArea : volume_[i] * volume_[j];
-            bondScale_[b] = w * measure / bonds_.restLength[b];
+            bondScale_[b] = bonds_.weight[b] * measure / bonds_.restLength[b];
         }
-        interiorWeightedVolume = std::max(interiorWeightedVolume, weightedVolume);
-    }
+    const double interiorWeightedVolume = interiorFamilySum(
+        bonds_, [&](int b) { return bonds_.weight[b] * volume_[bonds_.partners[b]]; });
     if (interiorWeightedVolume <= 0.0)
         throw std::invalid_argument(
             "no particle has a bond with non-zero weight: raise the horizon");
@@ -81,13 +77,9 @@ void Membrane::setUpFracture(const MembraneParams& params) {
     const MaterialParams& m = params.material;
     criticalStretch_ = std::numeric_limits<double>::infinity();
     if (m.fractureEnergy) {
-        double interiorMoment = 0.0;  // max_i sum_j W0 |xi| V_j
-        for (int i = 0; i < particleCount(); ++i) {
-            double sum = 0.0;
-            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-                sum += bonds_.weight[b] * bonds_.restLength[b] * volume_[bonds_.partners[b]];
-            interiorMoment = std::max(interiorMoment, sum);
-        }
+        const double interiorMoment = interiorFamilySum(bonds_, [&](int b) {  // sum_j W0 |xi| V_j
+            return bonds_.weight[b] * bonds_.restLength[b] * volume_[bonds_.partners[b]];
+        });
         criticalStretch_ =
             m.criticalStretch == CriticalStretchMode::Paper
                 ? paperCriticalStretch(*m.fractureEnergy, m.youngsModulus, horizon_)

@@ -98,19 +98,30 @@ struct BondLaw {
                    : 1.0;
     }
 
-    /// f(eta) = dPsi/deta for the elastic laws and the current elastoplastic state.
+    /// f(eta) = dPsi/deta for the elastic laws and the current elastoplastic state, for a law
+    /// known at compile time (the force loop is compiled once per law).
+    template <BondLawKind K>
+    double forceAs(double eta, const PlasticState& p = {}) const {
+        if constexpr (K == BondLawKind::Linear) {
+            return c * eta;  // eq. 18
+        } else if constexpr (K == BondLawKind::PowerLaw) {
+            const double s = 1.0 + eta;  // eq. 19
+            return 2.0 * powerC * (s - 1.0 / (s * s * s)) +
+                   powerCStar * powerN * (power(s, powerN - 1.0) - 1.0);
+        } else {
+            if (eta >= p.maxStrain && eta > yieldStrain) return yieldForce(eta);  // eq. 20
+            return c * (eta - plasticStrain(p));  // elastic, below the largest strain
+        }
+    }
+
     double force(double eta, const PlasticState& p = {}) const {
         switch (kind) {
             case BondLawKind::Linear:
-                return c * eta;  // eq. 18
-            case BondLawKind::PowerLaw: {
-                const double s = 1.0 + eta;  // eq. 19
-                return 2.0 * powerC * (s - 1.0 / (s * s * s)) +
-                       powerCStar * powerN * (power(s, powerN - 1.0) - 1.0);
-            }
+                return forceAs<BondLawKind::Linear>(eta, p);
+            case BondLawKind::PowerLaw:
+                return forceAs<BondLawKind::PowerLaw>(eta, p);
             case BondLawKind::Elastoplastic:
-                if (eta >= p.maxStrain && eta > yieldStrain) return yieldForce(eta);  // eq. 20
-                return c * (eta - plasticStrain(p));  // elastic, below the largest strain
+                return forceAs<BondLawKind::Elastoplastic>(eta, p);
         }
         return 0.0;
     }

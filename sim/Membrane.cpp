@@ -128,12 +128,11 @@ double Membrane::mechanicalStrain(int i, int b, double length, double& thetaBar)
 
 // Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
 // Both copies of a bond see the same strain bit for bit, so they break and yield together.
-template <bool kUpdateBonds>
-void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
+template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
+void Membrane::bondForcesFor(std::vector<Eigen::Vector3d>& force) {
     const int n = particleCount();
     force.resize(n);
     const auto& offsets = bonds_.offsets;
-    const bool plastic = !plastic_.empty();
     const MaterialParams& m = params_.material;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
@@ -141,23 +140,53 @@ void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
         const Eigen::Vector3d xi = x_[i];
         for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
             if (!bonds_.alive[b]) continue;
-            const Eigen::Vector3d r = x_[bonds_.partners[b]] - xi;
+            const int j = bonds_.partners[b];
+            const Eigen::Vector3d r = x_[j] - xi;
             const double length = r.norm();
-            double thetaBar;
-            const double eta = mechanicalStrain(i, b, length, thetaBar);
-            if (eta > criticalStretch_ * degradation(m.strengthLoss, thetaBar)) {  // eq. 27/28
-                if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
-                continue;
+            double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+            double thetaBar = 0.0;
+            if constexpr (kTheta) {  // see mechanicalStrain()
+                thetaBar = 0.5 * (theta_[i] + theta_[j]);
+                eta -= m.expansion * thetaBar;
+            }
+            if constexpr (kBreak) {  // eq. 27/28
+                double limit = criticalStretch_;
+                if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
+                if (eta > limit) {
+                    if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
+                    continue;
+                }
             }
             PlasticState state;
-            if (plastic) {
+            if constexpr (kLaw == BondLawKind::Elastoplastic) {
                 state = law_.yieldStep(eta, plastic_[b]);
                 if constexpr (kUpdateBonds) plastic_[b] = state;
             }
-            const double f = degradation(m.stiffnessLoss, thetaBar) * law_.force(eta, state);
+            double f = law_.forceAs<kLaw>(eta, state);
+            if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
             sum += (bondScale_[b] * f / length) * r;
         }
         force[i] = sum;
+    }
+}
+
+template <bool kUpdateBonds>
+void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
+    const bool theta = !theta_.empty();
+    const bool breakable = std::isfinite(criticalStretch_);
+    auto forLaw = [&]<BondLawKind kLaw>() {
+        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(force);
+        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(force);
+        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(force);
+        if (!theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, false, false>(force);
+    };
+    switch (law_.kind) {
+        case BondLawKind::Linear:
+            return forLaw.template operator()<BondLawKind::Linear>();
+        case BondLawKind::PowerLaw:
+            return forLaw.template operator()<BondLawKind::PowerLaw>();
+        case BondLawKind::Elastoplastic:
+            return forLaw.template operator()<BondLawKind::Elastoplastic>();
     }
 }
 

@@ -108,6 +108,10 @@ private:
     void setUpFracture(const MembraneParams& params);
     template <bool kUpdateBonds>
     void bondForces(std::vector<Eigen::Vector3d>& force);
+    /// The force loop compiled for one law and for whether theta exists and bonds can break,
+    /// so a stage a scene does not need costs nothing per bond.
+    template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
+    void bondForcesFor(std::vector<Eigen::Vector3d>& force);
     /// Mechanical strain of bond b of particle i (diffusion strain removed) and its theta_bar.
     double mechanicalStrain(int i, int b, double length, double& thetaBar) const;
     double degradation(double loss, double thetaBar) const {

@@ -8,10 +8,9 @@
 #include <memory>
 #include <sstream>
 
+#include "app/FrameWriter.h"
 #include "app/Outputs.h"
 #include "app/SceneError.h"
-#include "render/LatticeSurface.h"
-#include "render/OsmesaRenderer.h"
 
 namespace rend {
 namespace {
@@ -68,36 +67,25 @@ private:
     Clock::time_point start_;
 };
 
-// Surface and renderer, created only when a frame is to be drawn.
-class FrameWriter {
-public:
-    FrameWriter(const Scene& scene, const std::filesystem::path& dir) : scene_(scene), dir_(dir) {}
+// FNV-1a over the raw bytes of the final state: equal hashes mean bit-identical simulations,
+// which is how a test shows that rendering never changes the physics.
+std::string stateHash(const sim::Membrane& m) {
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    auto mix = [&](const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 0x100000001b3ULL;
+    };
+    mix(m.positions().data(), m.positions().size() * sizeof(Eigen::Vector3d));
+    mix(m.velocities().data(), m.velocities().size() * sizeof(Eigen::Vector3d));
+    mix(m.theta().data(), m.theta().size() * sizeof(double));
+    mix(m.bonds().alive.data(), m.bonds().alive.size());
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return hex;
+}
 
-    std::string write(const sim::FrameView& view, StageTimes& seconds) {
-        auto t0 = Clock::now();
-        if (!surface_) surface_ = std::make_unique<render::LatticeSurface>(view);
-        const render::Mesh mesh = surface_->build(view, scene_.render);
-        seconds.surface += secondsSince(t0);
-        t0 = Clock::now();
-        if (!renderer_) renderer_ = std::make_unique<render::OsmesaRenderer>();
-        const render::Image image = renderer_->render(mesh, scene_.render);
-        seconds.render += secondsSince(t0);
-        t0 = Clock::now();
-        char name[32];
-        std::snprintf(name, sizeof name, "frame_%04d.png", view.frame);
-        render::writePngAtomic(image, dir_ / name);
-        seconds.write += secondsSince(t0);
-        return (std::filesystem::path("frames") / name).string();
-    }
-
-private:
-    const Scene& scene_;
-    std::filesystem::path dir_;
-    std::unique_ptr<render::LatticeSurface> surface_;
-    std::unique_ptr<render::OsmesaRenderer> renderer_;
-};
-
-std::string runJson(const Scene& scene, const RunSummary& s, const std::string& status) {
+std::string runJson(const Scene& scene, const RunSummary& s, const std::string& status,
+                    const std::string& hash) {
     std::ostringstream j;
     j.precision(10);
     j << "{\n  \"rend_version\": " << jsonString(REND_VERSION) << ",\n"
@@ -113,6 +101,7 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << ", \"simulate\": " << s.seconds.simulate << ", \"surface\": " << s.seconds.surface
       << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write << "},\n"
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
+      << "  \"state_hash\": " << jsonString(hash) << ",\n"
       << "  \"resolved_scene\": " << (scene.resolvedJson.empty() ? "{}" : scene.resolvedJson)
       << "\n}\n";
     return j.str();
@@ -166,13 +155,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.substeps = substeps;
     const int frames = scene.frameCount();
     const auto [first, last] = options.frames.value_or(std::pair{1, frames});
-    const RendererKind renderer = options.renderer.value_or(scene.renderer);
 
     std::filesystem::create_directories(options.outDir);
-    const std::filesystem::path framesDir = options.outDir / "frames";
-    if (renderer != RendererKind::None) std::filesystem::create_directories(framesDir);
     StatsWriter stats(options.outDir / "stats.csv");
-    FrameWriter writer(scene, framesDir);
+    FrameWriter writer(scene, options.outDir);
     Progress progress(options.progressBar, last);
     s.seconds.setup = secondsSince(t0);
 
@@ -181,7 +167,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
         stats.finish();
-        writeFileAtomic(options.outDir / "run.json", runJson(scene, s, status));
+        writeFileAtomic(options.outDir / "run.json",
+                        runJson(scene, s, status, stateHash(membrane)));
     };
     try {
         for (int frame = 1; frame <= last; ++frame) {
@@ -191,13 +178,13 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             s.framesSimulated = frame;
             stats.append({frame, membrane.time(), membrane.kineticEnergy(), membrane.strainEnergy(),
                           membrane.maxSpeed(), membrane.maxTheta(), membrane.brokenBondCount()});
-            std::string wrote;
-            if (frame >= first && renderer != RendererKind::None) {
+            std::vector<std::string> wrote;
+            if (frame >= first && writer.active()) {
                 membrane.updateDamage();
                 wrote = writer.write(membrane.view(frame), s.seconds);
                 ++s.framesWritten;
             }
-            progress.frameDone(frame, membrane.time(), wrote);
+            progress.frameDone(frame, membrane.time(), wrote.empty() ? "" : wrote.front());
         }
     } catch (const sim::NumericalBlowUp&) {
         finish("blow-up");

@@ -15,7 +15,6 @@ namespace rend {
 struct RunOptions {
     std::filesystem::path outDir = "out";
     std::optional<std::pair<int, int>> frames;  ///< inclusive range of frames to write
-    std::optional<RendererKind> renderer;       ///< overrides the scene's [render] renderer
     bool progressBar = false;                   ///< redraw one line; else one line per frame
 };
 

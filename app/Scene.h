@@ -10,7 +10,10 @@
 
 namespace rend {
 
-enum class RendererKind { Osmesa, None };
+enum class RendererKind { Osmesa, None, Embree };
+
+/// Per-frame files besides the PNG: meshes through assimp, level sets through OpenVDB.
+enum class ExportFormat { Ply, Obj, Glb, Vdb };
 
 struct Scene {
     std::filesystem::path file;  ///< the scene file as given
@@ -18,6 +21,7 @@ struct Scene {
     render::RenderSettings render;
     RendererKind renderer = RendererKind::Osmesa;
     bool writeStats = true;
+    std::vector<ExportFormat> exports;  ///< [output] export, in the order given
 
     /// "file:line:column" of the time.dt value (or of [time] when dt is "auto"), so the
     /// pipeline can point at it when dt exceeds the stable bound.

@@ -28,7 +28,10 @@ constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 enum class Edge { Left, Right, Bottom, Top };
 constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
-constexpr std::string_view kRenderers[] = {"osmesa", "none"};
+constexpr std::string_view kRenderers[] = {"osmesa", "none", "embree"};
+constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
+constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};
+constexpr std::string_view kExportFormats[] = {"ply", "obj", "glb", "vdb"};
 constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
 
 /// Above this the lattice alone needs gigabytes and a frame takes minutes.
@@ -673,12 +676,72 @@ void readImage(const TableReader& t, Scene& scene) {
     r.colorRange = readColorRange(t);
 }
 
+void readPathTracing(const TableReader& t, render::PathTracing& p) {
+    constexpr Param kSpp{"spp", "path-traced samples per pixel", "16"};
+    constexpr Param kDepth{"max_depth", "the longest light path in bounces", "4"};
+    constexpr Param kMaterial{"material", "how the path tracer shades the sheet", "\"conductor\""};
+    constexpr Param kRoughness{"roughness", "the surface roughness (GGX alpha = roughness^2)",
+                               "0.35"};
+    constexpr Param kTransmission{"transmission", "the fraction of light passing through", "0.3"};
+    constexpr Param kSky{"sky", "a sky gradient instead of the constant background", "true"};
+    constexpr Param kSunRadius{"sun_radius", "the sun's angular radius in degrees", "2.0"};
+    p.samplesPerPixel = int(t.integer(kSpp, Range::closed(1, 4096)).value_or(p.samplesPerPixel));
+    p.maxDepth = int(t.integer(kDepth, Range::closed(1, 64)).value_or(p.maxDepth));
+    p.material =
+        render::MaterialKind(t.choice(kMaterial, kMaterials).value_or(std::size_t(p.material)));
+    p.roughness = t.number(kRoughness, Range::closed(0.01, 1.0)).value_or(p.roughness);
+    p.transmission = t.number(kTransmission, Range::closed(0.0, 1.0)).value_or(p.transmission);
+    p.sky = t.boolean(kSky).value_or(p.sky);
+    p.sunAngularRadiusDegrees =
+        t.number(kSunRadius, Range::closed(0.0, 30.0)).value_or(p.sunAngularRadiusDegrees);
+}
+
+void readSurface(const TableReader& t, render::RenderSettings& r) {
+    constexpr Param kSurface{"surface", "how each frame becomes a surface", "\"lattice\""};
+    constexpr Param kThickness{"thickness", "the lattice surface's extruded thickness in metres",
+                               "0.002"};
+    constexpr Param kVoxel{"vdb_voxel_size", "the level set's voxel size in metres (0: dx/2)",
+                           "0.01"};
+    constexpr Param kRadius{"vdb_particle_radius", "the particle radius in metres (0: 0.75 dx)",
+                            "0.015"};
+    constexpr Param kSmoothing{"vdb_smoothing", "level-set smoothing iterations", "1"};
+    constexpr Param kAdaptivity{"vdb_adaptivity", "volumeToMesh adaptivity", "0.1"};
+    r.surface = render::SurfaceKind(t.choice(kSurface, kSurfaces).value_or(std::size_t(r.surface)));
+    r.thickness = t.number(kThickness, Range::nonNegative()).value_or(r.thickness);
+    r.vdb.voxelSize = t.number(kVoxel, Range::nonNegative()).value_or(r.vdb.voxelSize);
+    r.vdb.particleRadius = t.number(kRadius, Range::nonNegative()).value_or(r.vdb.particleRadius);
+    r.vdb.smoothingIterations =
+        int(t.integer(kSmoothing, Range::closed(0, 20)).value_or(r.vdb.smoothingIterations));
+    r.vdb.adaptivity = t.number(kAdaptivity, Range::closed(0.0, 1.0)).value_or(r.vdb.adaptivity);
+}
+
 void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& scene) {
-    const TableReader t =
-        root.section({"render", "image settings", ""}, "[render]",
-                     {"renderer", "width", "height", "supersample", "color_by", "color_range",
-                      "albedo", "background", "ground_color", "ground", "ground_height"},
-                     sectionFix("render"));
+    const TableReader t = root.section({"render", "image settings", ""}, "[render]",
+                                       {"renderer",
+                                        "width",
+                                        "height",
+                                        "supersample",
+                                        "color_by",
+                                        "color_range",
+                                        "albedo",
+                                        "background",
+                                        "ground_color",
+                                        "ground",
+                                        "ground_height",
+                                        "spp",
+                                        "max_depth",
+                                        "material",
+                                        "roughness",
+                                        "transmission",
+                                        "sky",
+                                        "sun_radius",
+                                        "surface",
+                                        "thickness",
+                                        "vdb_voxel_size",
+                                        "vdb_particle_radius",
+                                        "vdb_smoothing",
+                                        "vdb_adaptivity"},
+                                       sectionFix("render"));
     constexpr Param kAlbedo{"albedo", "the surface colour [r, g, b]", "[0.78, 0.80, 0.85]"};
     constexpr Param kBackground{"background", "the sky colour [r, g, b]", "[0.80, 0.84, 0.90]"};
     constexpr Param kGroundColor{"ground_color", "the ground colour [r, g, b]",
@@ -688,6 +751,8 @@ void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& s
     const Range unit = Range::closed(0.0, 1.0);
     render::RenderSettings& r = scene.render;
     readImage(t, scene);
+    readPathTracing(t, r.pathTracing);
+    readSurface(t, r);
     r.albedo = t.vec3(kAlbedo, unit).value_or(r.albedo);
     r.background = t.vec3(kBackground, unit).value_or(r.background);
     r.groundColor = t.vec3(kGroundColor, unit).value_or(r.groundColor);
@@ -698,10 +763,28 @@ void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& s
 }
 
 void readOutput(const TableReader& root, Scene& scene) {
-    const TableReader t =
-        root.section({"output", "output options", ""}, "[output]", {"stats"}, sectionFix("output"));
+    const TableReader t = root.section({"output", "output options", ""}, "[output]",
+                                       {"stats", "export"}, sectionFix("output"));
     constexpr Param kStats{"stats", "whether to write per-frame statistics", "true"};
+    constexpr Param kExport{"export", "per-frame files: any of \"ply\", \"obj\", \"glb\", \"vdb\"",
+                            "[\"ply\", \"vdb\"]"};
     scene.writeStats = t.boolean(kStats).value_or(scene.writeStats);
+    const toml::node* list = t.find(kExport.key);
+    if (!list) return;
+    const toml::array* formats = list->as_array();
+    if (!formats)
+        t.fail(kExport.key, "an array of format names", scene::describeType(*list),
+               TableReader::useInstead(kExport));
+    for (const toml::node& item : *formats) {
+        const auto name = item.value<std::string>();
+        const auto* hit =
+            name ? std::find(std::begin(kExportFormats), std::end(kExportFormats), *name)
+                 : std::end(kExportFormats);
+        if (hit == std::end(kExportFormats))
+            t.fail(kExport.key, "format names among \"ply\", \"obj\", \"glb\", \"vdb\"",
+                   scene::describeType(item), TableReader::useInstead(kExport));
+        scene.exports.push_back(ExportFormat(hit - std::begin(kExportFormats)));
+    }
 }
 
 std::string toJson(const toml::table& document) {

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -41,19 +42,55 @@ int checkCommand(const std::string& file, const std::vector<std::string>& sets) 
 }
 
 struct RunArgs {
-    std::string scene, out = "out", frames, renderer;
+    std::string scene, out = "out", frames, renderer, surface, exports;
     std::vector<std::string> sets;
     int threads = 0;
+    int spp = 0;
 };
+
+std::vector<rend::ExportFormat> parseExports(const std::string& text) {
+    static const std::pair<const char*, rend::ExportFormat> kNames[] = {
+        {"ply", rend::ExportFormat::Ply},
+        {"obj", rend::ExportFormat::Obj},
+        {"glb", rend::ExportFormat::Glb},
+        {"vdb", rend::ExportFormat::Vdb}};
+    std::vector<rend::ExportFormat> formats;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string name = text.substr(start, end - start);
+        const auto* hit = std::find_if(std::begin(kNames), std::end(kNames),
+                                       [&](const auto& n) { return name == n.first; });
+        if (hit == std::end(kNames))
+            throw rend::SceneError("--export " + text +
+                                   ": error: expected a comma-separated list of "
+                                   "ply, obj, glb, vdb, found \"" +
+                                   name + "\". Use e.g. --export ply,vdb.");
+        formats.push_back(hit->second);
+        start = end + 1;
+    }
+    return formats;
+}
+
+// Command-line choices override the scene's, after it has been validated.
+void applyOverrides(const RunArgs& a, rend::Scene& scene) {
+    if (a.renderer == "none") scene.renderer = rend::RendererKind::None;
+    if (a.renderer == "osmesa") scene.renderer = rend::RendererKind::Osmesa;
+    if (a.renderer == "embree") scene.renderer = rend::RendererKind::Embree;
+    if (a.surface == "lattice") scene.render.surface = rend::render::SurfaceKind::Lattice;
+    if (a.surface == "splat") scene.render.surface = rend::render::SurfaceKind::Splat;
+    if (a.surface == "vdb") scene.render.surface = rend::render::SurfaceKind::Vdb;
+    if (!a.exports.empty()) scene.exports = parseExports(a.exports);
+    if (a.spp > 0) scene.render.pathTracing.samplesPerPixel = a.spp;
+}
 
 int runCommand(const RunArgs& a) {
     if (a.threads > 0) omp_set_num_threads(a.threads);
-    const rend::Scene scene = rend::loadScene(a.scene, a.sets);
+    rend::Scene scene = rend::loadScene(a.scene, a.sets);
+    applyOverrides(a, scene);
     rend::RunOptions options;
     options.outDir = a.out;
     if (!a.frames.empty()) options.frames = rend::parseFrameRange(a.frames, scene.frameCount());
-    if (a.renderer == "none") options.renderer = rend::RendererKind::None;
-    if (a.renderer == "osmesa") options.renderer = rend::RendererKind::Osmesa;
     options.progressBar = isatty(STDERR_FILENO);
     const rend::RunSummary s = rend::runScene(scene, options);
     std::printf(
@@ -78,7 +115,12 @@ int main(int argc, char** argv) {
     runCmd->add_option("--out", run.out, "Output folder")->capture_default_str();
     runCmd->add_option("--frames", run.frames, "Frames to write: N or FIRST-LAST");
     runCmd->add_option("--renderer", run.renderer, "Override [render] renderer")
-        ->check(CLI::IsMember({"osmesa", "none"}));
+        ->check(CLI::IsMember({"osmesa", "embree", "none"}));
+    runCmd->add_option("--surface", run.surface, "Override [render] surface")
+        ->check(CLI::IsMember({"lattice", "splat", "vdb"}));
+    runCmd->add_option("--export", run.exports, "Per-frame exports, e.g. ply,obj,glb,vdb");
+    runCmd->add_option("--spp", run.spp, "Path-traced samples per pixel (embree)")
+        ->check(CLI::Range(1, 4096));
     runCmd->add_option("--threads", run.threads, "OpenMP threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     runCmd->add_option("--set", run.sets, "Override a scene value: key.path=value (repeatable)");

@@ -39,4 +39,19 @@ GlMatrix lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
     return m;
 }
 
+ViewBasis viewBasis(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                    const Eigen::Vector3d& up) {
+    // The rows of lookAt's rotation are s, u and -f.
+    const GlMatrix m = lookAt(eye, target, up);
+    return {Eigen::Vector3d(m[0], m[4], m[8]), Eigen::Vector3d(m[1], m[5], m[9]),
+            -Eigen::Vector3d(m[2], m[6], m[10])};
+}
+
+Eigen::Vector3d cameraRayDirection(const ViewBasis& basis, double fovYDegrees, double aspect,
+                                   double ndcX, double ndcY) {
+    // perspective() maps a view-space direction (x, y, -1) to ndc (x f / aspect, y f).
+    const double tanHalf = std::tan(fovYDegrees * std::numbers::pi / 360.0);
+    return basis.forward + basis.right * (ndcX * tanHalf * aspect) + basis.up * (ndcY * tanHalf);
+}
+
 }  // namespace rend::render::detail

@@ -15,4 +15,20 @@ GlMatrix perspective(double fovYDegrees, double aspect, double zNear, double zFa
 GlMatrix lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                 const Eigen::Vector3d& up);
 
+/// The camera frame that lookAt() builds (right, up, forward), read back from its matrix so a
+/// ray tracer frames a scene exactly as the rasterizer does, fallback up vectors included.
+struct ViewBasis {
+    Eigen::Vector3d right;
+    Eigen::Vector3d up;
+    Eigen::Vector3d forward;
+};
+ViewBasis viewBasis(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                    const Eigen::Vector3d& up);
+
+/// World-space direction (not normalised) through normalised device coordinates
+/// (ndcX, ndcY) in [-1, 1]^2, +y up, of perspective(fovYDegrees, aspect, ...): the inverse of
+/// the projection for a pinhole camera with the frame `basis`.
+Eigen::Vector3d cameraRayDirection(const ViewBasis& basis, double fovYDegrees, double aspect,
+                                   double ndcX, double ndcY);
+
 }  // namespace rend::render::detail

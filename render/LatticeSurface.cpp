@@ -68,6 +68,98 @@ int vertexCount(const sim::FrameView& rest, const std::vector<std::array<int, 3>
     return n;
 }
 
+// Edges used by exactly one triangle, directed as that triangle walks them. With the fans
+// split at cracks these are the sheet's outline and both lips of every crack.
+std::vector<std::array<std::uint32_t, 2>> boundaryEdges(
+    const std::vector<std::array<std::uint32_t, 3>>& tris) {
+    struct Directed {
+        std::uint64_t key;  // undirected: (min, max)
+        std::uint32_t from, to;
+    };
+    std::vector<Directed> edges;
+    edges.reserve(tris.size() * 3);
+    for (const auto& t : tris) {
+        for (int e = 0; e < 3; ++e) {
+            const std::uint32_t a = t[e];
+            const std::uint32_t b = t[(e + 1) % 3];
+            const auto [lo, hi] = std::minmax(a, b);
+            edges.push_back({(std::uint64_t(lo) << 32) | hi, a, b});
+        }
+    }
+    std::sort(edges.begin(), edges.end(),
+              [](const Directed& x, const Directed& y) { return x.key < y.key; });
+    std::vector<std::array<std::uint32_t, 2>> boundary;
+    for (std::size_t i = 0; i < edges.size();) {
+        std::size_t j = i + 1;
+        while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+        if (j - i == 1) boundary.push_back({edges[i].from, edges[i].to});
+        i = j;
+    }
+    return boundary;
+}
+
+// Outward wall normals, one per boundary vertex: the sum over its boundary edges of
+// (b - a) x n, which points away from the kept triangle on a counter-clockwise edge a -> b.
+std::vector<Eigen::Vector3f> wallNormals(const Mesh& sheet,
+                                         const std::vector<std::array<std::uint32_t, 2>>& edges) {
+    std::vector<Eigen::Vector3f> normals(sheet.positions.size(), Eigen::Vector3f::Zero());
+    for (const auto& [a, b] : edges) {
+        const Eigen::Vector3f n = sheet.normals[a] + sheet.normals[b];
+        const Eigen::Vector3f out = (sheet.positions[b] - sheet.positions[a]).cross(n);
+        normals[a] += out;
+        normals[b] += out;
+    }
+    for (auto& n : normals) n.normalize();
+    return normals;
+}
+
+// Wall vertices get their own copies (with the wall's normal), so the rim is shaded as a wall
+// rather than smeared between the two faces; their positions are exact copies of the face
+// vertices, so the solid is closed once coincident vertices are welded.
+void addWalls(Mesh& mesh, std::uint32_t sheetVertices,
+              const std::vector<std::array<std::uint32_t, 2>>& edges,
+              const std::vector<Eigen::Vector3f>& normals) {
+    std::vector<std::uint32_t> wall(sheetVertices, kUnassigned);  // top copy; bottom is + 1
+    auto wallVertex = [&](std::uint32_t v) {
+        if (wall[v] != kUnassigned) return wall[v];
+        wall[v] = static_cast<std::uint32_t>(mesh.positions.size());
+        for (std::uint32_t face : {v, v + sheetVertices}) {
+            mesh.positions.push_back(mesh.positions[face]);
+            mesh.normals.push_back(normals[v]);
+            mesh.colors.push_back(mesh.colors[v]);
+        }
+        return wall[v];
+    };
+    for (const auto& [a, b] : edges) {
+        const std::uint32_t ta = wallVertex(a);
+        const std::uint32_t tb = wallVertex(b);
+        mesh.triangles.push_back({ta, ta + 1, tb + 1});
+        mesh.triangles.push_back({ta, tb + 1, tb});
+    }
+}
+
+// The sheet offset by +-thickness/2 along its vertex normals (the bottom copy wound the other
+// way so it faces out) and closed by walls along every boundary edge.
+void extrude(Mesh& mesh, double thickness) {
+    const auto n = static_cast<std::uint32_t>(mesh.positions.size());
+    const auto edges = boundaryEdges(mesh.triangles);
+    const auto walls = wallNormals(mesh, edges);
+    const float half = static_cast<float>(0.5 * thickness);
+    mesh.positions.reserve(2 * n + 2 * edges.size());
+    for (std::uint32_t v = 0; v < n; ++v) {
+        mesh.positions.push_back(mesh.positions[v] - half * mesh.normals[v]);
+        mesh.positions[v] += half * mesh.normals[v];
+        mesh.normals.push_back(-mesh.normals[v]);
+        mesh.colors.push_back(mesh.colors[v]);
+    }
+    const std::size_t faces = mesh.triangles.size();
+    for (std::size_t t = 0; t < faces; ++t) {
+        const auto tri = mesh.triangles[t];
+        mesh.triangles.push_back({tri[0] + n, tri[2] + n, tri[1] + n});
+    }
+    addWalls(mesh, n, edges, walls);
+}
+
 }  // namespace
 
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
@@ -172,6 +264,7 @@ Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& se
     mesh.colors = particleColors(frame, settings);
     mesh.colors.reserve(mesh.positions.size());
     for (int p : corners.copyOf) mesh.colors.push_back(mesh.colors[p]);
+    if (settings.thickness > 0.0) extrude(mesh, settings.thickness);
     return mesh;
 }
 

@@ -33,6 +33,14 @@ public:
     /// Triangles whose three edge bonds are intact, with vertices duplicated along cracks
     /// (see above), smooth (area-weighted) normals per vertex and per-vertex colours from the
     /// settings' ColorBy.
+    ///
+    /// With settings.thickness > 0 the sheet becomes a solid: the mesh above, offset by
+    /// +thickness/2 along the vertex normals (same vertex indices, so vertices
+    /// [0, particleCount) are still the particles), a copy offset by -thickness/2 facing the
+    /// other way (indices + the sheet's vertex count), then walls along every edge used by a
+    /// single kept triangle, with their own vertices and outward normals, so the outline and
+    /// both lips of every crack show as walls. Welding coincident vertices makes it closed.
+    /// Large thicknesses on sharply folded sheets self-intersect: it is an offset, not a CSG.
     Mesh build(const sim::FrameView& frame, const RenderSettings& settings) const;
 
     /// Indices into FrameView::restTriangles of the triangles kept in this frame.

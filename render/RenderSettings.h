@@ -24,6 +24,34 @@ struct DirectionalLight {
     double intensity = 0.85;
 };
 
+/// Surface reconstruction of a frame (DESIGN.md, "Surfaces and rendering").
+enum class SurfaceKind { Lattice, Splat, Vdb };
+
+/// How the path tracer shades the membrane. Conductor: rough GGX metal (aluminium foil).
+/// Film: translucent rough dielectric-like sheet (rubbery film). Translucent: thin diffuse with
+/// transmission (seaweed, paper towel). Diffuse: plain Lambert.
+enum class MaterialKind { Diffuse, Conductor, Film, Translucent };
+
+struct PathTracing {
+    int samplesPerPixel = 16;
+    int maxDepth = 4;
+    MaterialKind material = MaterialKind::Diffuse;
+    double roughness = 0.35;    ///< GGX alpha = roughness^2
+    double transmission = 0.0;  ///< fraction of light passing through (film, translucent)
+    bool sky = true;            ///< sky gradient (zenith -> horizon); false: constant background
+    Eigen::Vector3d skyZenith{0.35, 0.50, 0.80};
+    Eigen::Vector3d skyHorizon{0.85, 0.88, 0.92};
+    double sunAngularRadiusDegrees = 2.0;  ///< soft shadows
+};
+
+/// OpenVDB level set of the particles (ParticlesToLevelSet -> volumeToMesh).
+struct VdbSettings {
+    double voxelSize = 0.0;       ///< 0: dx / 2
+    double particleRadius = 0.0;  ///< 0: 0.75 dx (>= 1.5 voxels, or OpenVDB skips particles)
+    int smoothingIterations = 1;  ///< light mean-curvature smoothing; must not open holes
+    double adaptivity = 0.1;      ///< volumeToMesh adaptivity in [0, 1]
+};
+
 struct RenderSettings {
     int width = 960;
     int height = 540;
@@ -38,6 +66,10 @@ struct RenderSettings {
     Eigen::Vector3d albedo{0.78, 0.80, 0.85};  ///< material colour when ColorBy::None
     ColorBy colorBy = ColorBy::None;
     std::optional<std::array<double, 2>> colorRange;  ///< nullopt: 0..max of the frame
+    SurfaceKind surface = SurfaceKind::Lattice;
+    double thickness = 0.0;  ///< lattice surface extruded to this thickness [m]; 0: a sheet
+    PathTracing pathTracing;
+    VdbSettings vdb;
 };
 
 }  // namespace rend::render

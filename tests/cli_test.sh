@@ -84,5 +84,31 @@ check "only frames 5-6 written" test "$(ls "$tmp/range/frames" | tr '\n' ' ')" =
 check "renderer none" run 0 run scenes/stretch.toml "${small[@]}" --renderer none --out "$tmp/none"
 check "renderer none writes no frames" test ! -e "$tmp/none/frames"
 
+# Skipping: --renderer none with no export builds no surface, and the simulation is bitwise the
+# same with and without rendering and exports (run.json's state_hash covers x, v, theta, bonds).
+json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2], {}, {'d': d}))" "$@"; }
+check "no surface without outputs" python3 -c "import json,sys; w=json.load(open(sys.argv[1]))['wall_seconds']; assert w['surface'] == 0 and w['render'] == 0" "$tmp/none/run.json"
+check "surface built when rendering" python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['wall_seconds']['surface'] > 0" "$tmp/ok/run.json"
+check "simulation identical with and without rendering" test "$(json "$tmp/none/run.json" "d['state_hash']")" = "$(json "$tmp/ok/run.json" "d['state_hash']")"
+
+# Exports and surfaces.
+check "exports" run 0 run scenes/stretch.toml "${small[@]}" --renderer none --export ply,obj,glb,vdb \
+    --frames 6 --out "$tmp/export"
+for f in meshes/frame_0006.ply meshes/frame_0006.obj meshes/frame_0006.glb vdb/frame_0006.vdb; do
+    check "export writes $f" test -s "$tmp/export/$f"
+done
+check "exports leave no partial files" no_partial_files "$tmp/export"
+check "exports keep the simulation identical" test "$(json "$tmp/export/run.json" "d['state_hash']")" = "$(json "$tmp/ok/run.json" "d['state_hash']")"
+check "bad --export refused" run 2 run scenes/stretch.toml "${small[@]}" --export ply,stl --out "$tmp/badexport"
+check "bad --export leaves no output" test ! -e "$tmp/badexport"
+for surface in splat vdb; do
+    for renderer in osmesa embree; do
+        check "$surface surface with $renderer" run 0 run scenes/stretch.toml "${small[@]}" \
+            --surface $surface --renderer $renderer --spp 2 --frames 6 --out "$tmp/$surface$renderer" \
+            --set render.width=64 --set render.height=36
+        check "$surface/$renderer frame written" test -s "$tmp/$surface$renderer/frames/frame_0006.png"
+    done
+done
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

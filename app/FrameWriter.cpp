@@ -1,0 +1,130 @@
+#include "app/FrameWriter.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "app/Pipeline.h"
+#include "render/EmbreeRenderer.h"
+#include "render/LatticeSurface.h"
+#include "render/MeshExport.h"
+#include "render/OsmesaRenderer.h"
+#include "render/SplatSurface.h"
+#include "render/VdbSurface.h"
+
+namespace rend {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string frameName(int frame, const char* extension) {
+    char name[40];
+    std::snprintf(name, sizeof name, "frame_%04d.%s", frame, extension);
+    return name;
+}
+
+const render::Mesh& asMesh(const render::Geometry& geometry, render::Mesh& scratch) {
+    if (const auto* mesh = std::get_if<render::Mesh>(&geometry)) return *mesh;
+    scratch = render::splatsToMesh(std::get<render::Splats>(geometry));
+    return scratch;
+}
+
+}  // namespace
+
+struct FrameWriter::Parts {
+    std::unique_ptr<render::LatticeSurface> lattice;
+    std::unique_ptr<render::SplatSurface> splat;
+    std::unique_ptr<render::VdbSurface> vdb;  ///< the vdb surface, or the level set for export
+    std::unique_ptr<render::OsmesaRenderer> osmesa;
+    std::unique_ptr<render::EmbreeRenderer> embree;
+};
+
+FrameWriter::FrameWriter(const Scene& scene, const std::filesystem::path& outDir)
+    : scene_(scene), outDir_(outDir), parts_(std::make_unique<Parts>()) {}
+
+FrameWriter::~FrameWriter() = default;
+
+bool FrameWriter::active() const {
+    return scene_.renderer != RendererKind::None || !scene_.exports.empty();
+}
+
+render::Geometry FrameWriter::buildSurface(const sim::FrameView& view) {
+    Parts& p = *parts_;
+    switch (scene_.render.surface) {
+        case render::SurfaceKind::Splat:
+            if (!p.splat) p.splat = std::make_unique<render::SplatSurface>(view);
+            return p.splat->build(view, scene_.render);
+        case render::SurfaceKind::Vdb:
+            if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
+            return p.vdb->build(view, scene_.render);
+        case render::SurfaceKind::Lattice:
+            break;
+    }
+    if (!p.lattice) p.lattice = std::make_unique<render::LatticeSurface>(view);
+    return p.lattice->build(view, scene_.render);
+}
+
+render::Image FrameWriter::renderImage(const render::Geometry& geometry) {
+    Parts& p = *parts_;
+    if (scene_.renderer == RendererKind::Embree) {
+        if (!p.embree) p.embree = std::make_unique<render::EmbreeRenderer>();
+        return p.embree->render(geometry, scene_.render);
+    }
+    if (!p.osmesa) p.osmesa = std::make_unique<render::OsmesaRenderer>();
+    render::Mesh scratch;
+    return p.osmesa->render(asMesh(geometry, scratch), scene_.render);
+}
+
+void FrameWriter::exportFrame(const sim::FrameView& view, const render::Geometry& geometry,
+                              std::vector<std::string>& written) {
+    render::Mesh scratch;
+    for (ExportFormat format : scene_.exports) {
+        if (format == ExportFormat::Vdb) {
+            Parts& p = *parts_;
+            if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
+            // The vdb surface built its level set already; any other surface builds it here.
+            if (scene_.render.surface != render::SurfaceKind::Vdb)
+                p.vdb->build(view, scene_.render);
+            std::filesystem::create_directories(outDir_ / "vdb");
+            const std::string name = "vdb/" + frameName(view.frame, "vdb");
+            p.vdb->writeVdb(outDir_ / name);
+            written.push_back(name);
+            continue;
+        }
+        static constexpr const char* kExtensions[] = {"ply", "obj", "glb"};
+        const char* extension = kExtensions[int(format)];
+        std::filesystem::create_directories(outDir_ / "meshes");
+        const std::string name = std::string("meshes/") + frameName(view.frame, extension);
+        render::exportMesh(asMesh(geometry, scratch), outDir_ / name,
+                           render::MeshFormat(int(format)));
+        written.push_back(name);
+    }
+}
+
+std::vector<std::string> FrameWriter::write(const sim::FrameView& view, StageTimes& seconds) {
+    std::vector<std::string> written;
+    if (!active()) return written;
+    auto t0 = Clock::now();
+    const render::Geometry geometry = buildSurface(view);
+    seconds.surface += secondsSince(t0);
+    if (scene_.renderer != RendererKind::None) {
+        t0 = Clock::now();
+        const render::Image image = renderImage(geometry);
+        seconds.render += secondsSince(t0);
+        t0 = Clock::now();
+        std::filesystem::create_directories(outDir_ / "frames");
+        const std::string name = "frames/" + frameName(view.frame, "png");
+        render::writePngAtomic(image, outDir_ / name);
+        written.push_back(name);
+        seconds.write += secondsSince(t0);
+    }
+    t0 = Clock::now();
+    exportFrame(view, geometry, written);
+    seconds.write += secondsSince(t0);
+    return written;
+}
+
+}  // namespace rend

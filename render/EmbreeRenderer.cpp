@@ -1,0 +1,864 @@
+#include "render/EmbreeRenderer.h"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "render/GlMath.h"
+
+namespace rend::render {
+
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "Vector3f arrays are copied as packed floats");
+
+constexpr float kPi = std::numbers::pi_v<float>;
+// Same encoding as OsmesaRenderer, so the two renderers' frames are comparable.
+constexpr double kGamma = 2.2;
+constexpr int kTileSize = 16;
+// Fresnel reflectance at normal incidence of a dielectric with IOR 1.5: ((n - 1) / (n + 1))^2.
+constexpr float kFilmF0 = 0.04f;
+// Russian roulette only after a few bounces: the early ones carry most of the image.
+constexpr int kRouletteDepth = 3;
+// Firefly clamp: a contribution after the first bounce is scaled down to at most this linear
+// value per channel. Display white is 1.0, so ordinary sky and sun light is untouched; only
+// rare diffuse -> glossy -> sun paths (caustics the sampler finds once in thousands) are cut.
+constexpr float kIndirectClamp = 4.0f;
+// A film shadow ray passes through at most this many sheet layers before it counts as blocked.
+constexpr int kMaxShadowLayers = 8;
+// Slightly below GGX's singular alpha = 0 (a perfect mirror), which NEE cannot evaluate.
+constexpr float kMinAlpha = 1e-3f;
+
+// ---- Counter-based random numbers ------------------------------------------------------------
+
+// SplitMix64's finaliser (Steele, Lea & Flood 2014): a bijective 64-bit avalanche mix.
+std::uint64_t mix64(std::uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+std::uint32_t reverseBits(std::uint32_t x) {
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00FF00FFu) << 8) | ((x & 0xFF00FF00u) >> 8);
+    x = ((x & 0x0F0F0F0Fu) << 4) | ((x & 0xF0F0F0F0u) >> 4);
+    x = ((x & 0x33333333u) << 2) | ((x & 0xCCCCCCCCu) >> 2);
+    return ((x & 0x55555555u) << 1) | ((x & 0xAAAAAAAAu) >> 1);
+}
+
+/// Second dimension of the Sobol sequence: its generator matrix is Pascal's triangle mod 2,
+/// whose columns follow v_{k+1} = v_k ^ (v_k >> 1). With the van der Corput first dimension
+/// the pair is a (0, 2)-sequence: every 2^k prefix stratifies the unit square.
+std::uint32_t sobolSecond(std::uint32_t index) {
+    std::uint32_t result = 0;
+    for (std::uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
+        if (index & 1u) result ^= v;
+    return result;
+}
+
+float unitFloat(std::uint32_t bits) { return float(bits >> 8) * 0x1p-24f; }  // [0, 1), never 1
+
+/// Random numbers of one (pixel, sample) path, a pure function of (pixel, sample, dimension):
+/// the n-th request of a path always gets the same value, so a pixel never depends on which
+/// thread renders it, or in which order. 2D requests (camera jitter, sun cone, BSDF lobe
+/// shape) are points of the Sobol (0, 2)-sequence, randomised per pixel and dimension by a
+/// digit XOR (which keeps the stratification) and an index XOR (which shuffles the samples of
+/// different dimensions against each other, and for a power-of-two spp permutes whole nets):
+/// far less noise at 16 spp than independent numbers. 1D requests (lobe choice, roulette) use
+/// the first dimension alone, randomised the same way.
+class Sampler {
+public:
+    Sampler(std::uint64_t pixel, std::uint32_t sample, std::uint32_t samples)
+        : pixelKey_(mix64(pixel)), sample_(sample), indexMask_(std::bit_ceil(samples) - 1) {}
+
+    float next1D() {
+        const std::uint64_t h = dimensionHash();
+        const std::uint32_t index = sample_ ^ (std::uint32_t(h) & indexMask_);
+        return unitFloat(reverseBits(index) ^ std::uint32_t(mix64(h)));
+    }
+
+    std::array<float, 2> next2D() {
+        const std::uint64_t h = dimensionHash();
+        const std::uint32_t index = sample_ ^ (std::uint32_t(h) & indexMask_);
+        const std::uint64_t scramble = mix64(h);
+        return {unitFloat(reverseBits(index) ^ std::uint32_t(scramble)),
+                unitFloat(sobolSecond(index) ^ std::uint32_t(scramble >> 32))};
+    }
+
+private:
+    /// Independent of the sample index: the scrambles are shared by a pixel's samples.
+    std::uint64_t dimensionHash() {
+        return mix64(pixelKey_ ^ (++dimension_ * 0x9E3779B97F4A7C15ULL));
+    }
+
+    std::uint64_t pixelKey_;
+    std::uint32_t sample_;
+    std::uint32_t indexMask_;
+    std::uint64_t dimension_ = 0;
+};
+
+// ---- Small vector helpers --------------------------------------------------------------------
+
+float maxComponent(const Vec3& v) { return v.maxCoeff(); }
+
+Vec3 toFloat(const Eigen::Vector3d& v) { return v.cast<float>(); }
+
+/// Orthonormal basis around a unit normal, n as local +z (Duff et al. 2017, "Building an
+/// Orthonormal Basis, Revisited"): no branch on a preferred axis, no singularity.
+struct Frame {
+    Vec3 t, b, n;
+
+    explicit Frame(const Vec3& normal) : n(normal) {
+        const float sign = std::copysign(1.0f, n.z());
+        const float a = -1.0f / (sign + n.z());
+        const float c = n.x() * n.y() * a;
+        t = Vec3(1.0f + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+        b = Vec3(c, sign + n.y() * n.y() * a, -n.y());
+    }
+    Vec3 toLocal(const Vec3& v) const { return Vec3(v.dot(t), v.dot(b), v.dot(n)); }
+    Vec3 toWorld(const Vec3& v) const { return v.x() * t + v.y() * b + v.z() * n; }
+};
+
+Vec3 sampleCosineHemisphere(float u1, float u2) {
+    const float r = std::sqrt(u1);
+    const float phi = 2.0f * kPi * u2;
+    return Vec3(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1)));
+}
+
+// ---- GGX microfacet model (Walter et al. 2007, "Microfacet Models for Refraction through
+// Rough Surfaces"), in the local frame where the shading normal is +z ------------------------
+
+float ggxD(const Vec3& h, float alpha) {
+    const float a2 = alpha * alpha;
+    const float d = h.z() * h.z() * (a2 - 1.0f) + 1.0f;
+    return a2 / (kPi * d * d);
+}
+
+/// Smith's Lambda for GGX; G1 = 1 / (1 + Lambda), height-correlated G2 = 1 / (1 + L(o) + L(i))
+/// (Heitz 2014, "Understanding the Masking-Shadowing Function").
+float ggxLambda(const Vec3& v, float alpha) {
+    const float cos2 = v.z() * v.z();
+    const float tan2 = std::max(0.0f, 1.0f - cos2) / std::max(cos2, 1e-12f);
+    return 0.5f * (std::sqrt(1.0f + alpha * alpha * tan2) - 1.0f);
+}
+
+/// Schlick 1994: F = F0 + (1 - F0)(1 - cos)^5.
+Vec3 schlick(const Vec3& f0, float cosTheta) {
+    const float m = std::clamp(1.0f - cosTheta, 0.0f, 1.0f);
+    const float m5 = (m * m) * (m * m) * m;
+    return f0 + (Vec3::Ones() - f0) * m5;
+}
+
+float schlick(float f0, float cosTheta) { return schlick(Vec3::Constant(f0), cosTheta).x(); }
+
+/// A microfacet normal drawn from GGX's distribution of normals visible from wo (Heitz 2018,
+/// "Sampling the GGX Distribution of Visible Normals"): the pdf cancels D and G1, so the
+/// sample weight is G2 / G1 <= 1 and grazing views do not blow up.
+Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {
+    const Vec3 vh = Vec3(alpha * wo.x(), alpha * wo.y(), wo.z()).normalized();
+    const float lensq = vh.x() * vh.x() + vh.y() * vh.y();
+    const Vec3 t1 =
+        lensq > 0.0f ? Vec3(Vec3(-vh.y(), vh.x(), 0.0f) / std::sqrt(lensq)) : Vec3(Vec3::UnitX());
+    const Vec3 t2 = vh.cross(t1);
+    const float r = std::sqrt(u1);
+    const float phi = 2.0f * kPi * u2;
+    const float p1 = r * std::cos(phi);
+    const float s = 0.5f * (1.0f + vh.z());
+    const float p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * r * std::sin(phi);
+    const Vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+    return Vec3(alpha * nh.x(), alpha * nh.y(), std::max(0.0f, nh.z())).normalized();
+}
+
+/// GGX reflection lobe times cos(wi): D G2 / (4 cos(wo)), Fresnel left to the caller.
+float ggxReflection(const Vec3& wo, const Vec3& wi, float alpha) {
+    const Vec3 h = (wo + wi).normalized();
+    const float g2 = 1.0f / (1.0f + ggxLambda(wo, alpha) + ggxLambda(wi, alpha));
+    return ggxD(h, alpha) * g2 / (4.0f * wo.z());
+}
+
+Vec3 reflect(const Vec3& wo, const Vec3& h) { return 2.0f * wo.dot(h) * h - wo; }
+
+// ---- Materials -------------------------------------------------------------------------------
+
+/// One shading point's scattering, in the local frame (wo.z > 0: the normal faces the viewer).
+/// Reflection leaves with wi.z > 0, transmission with wi.z < 0.
+struct Bsdf {
+    MaterialKind kind = MaterialKind::Diffuse;
+    Vec3 albedo = Vec3::Constant(0.5f);
+    float alpha = 0.1f;
+    float transmission = 0.0f;
+
+    /// f(wo, wi) |cos(wi)|: what next-event estimation multiplies the sun's irradiance by.
+    Vec3 evalCos(const Vec3& wo, const Vec3& wi) const;
+
+    /// Draws wi; `weight` = f |cos| / pdf (each component <= 1). False: the path is absorbed.
+    bool sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight) const;
+
+    /// Fraction of light passing straight through (film only; other sheets are opaque to
+    /// shadow rays).
+    Vec3 straightTransmission(float cosTheta) const {
+        if (kind != MaterialKind::Film) return Vec3::Zero();
+        return (1.0f - schlick(kFilmF0, cosTheta)) * transmission * albedo;
+    }
+};
+
+Vec3 Bsdf::evalCos(const Vec3& wo, const Vec3& wi) const {
+    const float lambert = std::abs(wi.z()) / kPi;
+    switch (kind) {
+        case MaterialKind::Diffuse:
+            return wi.z() > 0.0f ? Vec3(albedo * lambert) : Vec3::Zero();
+        case MaterialKind::Conductor: {
+            if (wi.z() <= 0.0f) return Vec3::Zero();
+            const Vec3 f = schlick(albedo, wo.dot((wo + wi).normalized()));
+            return f * ggxReflection(wo, wi, alpha);
+        }
+        case MaterialKind::Film: {
+            // The straight-through part is a delta lobe: NEE cannot hit it.
+            if (wi.z() <= 0.0f) return Vec3::Zero();
+            const float fo = schlick(kFilmF0, wo.z());
+            const Vec3 diffuse = (1.0f - fo) * (1.0f - transmission) * albedo * lambert;
+            return Vec3::Constant(fo * ggxReflection(wo, wi, alpha)) + diffuse;
+        }
+        case MaterialKind::Translucent: {
+            const float side = wi.z() > 0.0f ? 1.0f - transmission : transmission;
+            return side * albedo * lambert;
+        }
+    }
+    return Vec3::Zero();
+}
+
+bool Bsdf::sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight) const {
+    const float u0 = rng.next1D();
+    const auto [u1, u2] = rng.next2D();
+    switch (kind) {
+        case MaterialKind::Diffuse:
+            wi = sampleCosineHemisphere(u1, u2);
+            weight = albedo;
+            return true;
+        case MaterialKind::Conductor: {
+            const Vec3 h = sampleGgxVisibleNormal(wo, alpha, u1, u2);
+            wi = reflect(wo, h);
+            if (wi.z() <= 0.0f) return false;  // reflected into the surface: masked
+            const float g1 = 1.0f / (1.0f + ggxLambda(wo, alpha));
+            const float g2 = 1.0f / (1.0f + ggxLambda(wo, alpha) + ggxLambda(wi, alpha));
+            weight = schlick(albedo, wo.dot(h)) * (g2 / g1);
+            return true;
+        }
+        case MaterialKind::Film: {
+            // Lobes chosen with probabilities equal to their weights: Fresnel (taken at the
+            // macro normal, hence "dielectric-ish") for the gloss, then transmission, then
+            // diffuse, so every sample's weight stays <= 1.
+            const float fo = schlick(kFilmF0, wo.z());
+            if (u0 < fo) {
+                wi = reflect(wo, sampleGgxVisibleNormal(wo, alpha, u1, u2));
+                if (wi.z() <= 0.0f) return false;
+                const float g1 = 1.0f / (1.0f + ggxLambda(wo, alpha));
+                const float g2 = 1.0f / (1.0f + ggxLambda(wo, alpha) + ggxLambda(wi, alpha));
+                weight = Vec3::Constant(g2 / g1);
+                return true;
+            }
+            weight = albedo;
+            if ((u0 - fo) / (1.0f - fo) < transmission) {
+                wi = -wo;  // a thin sheet: no refraction offset
+                return true;
+            }
+            wi = sampleCosineHemisphere(u1, u2);
+            return true;
+        }
+        case MaterialKind::Translucent:
+            wi = sampleCosineHemisphere(u1, u2);
+            if (u0 < transmission) wi.z() = -wi.z();
+            weight = albedo;
+            return true;
+    }
+    return false;
+}
+
+// ---- Scene traversal -------------------------------------------------------------------------
+
+struct SurfaceHit {
+    float t = std::numeric_limits<float>::infinity();
+    Vec3 position;
+    Vec3 geometricNormal;  ///< unit, facing the incoming ray
+    Vec3 shadingNormal;    ///< unit, on the same side as geometricNormal
+    Vec3 albedo;
+    bool ground = false;
+    std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the disc or triangle hit
+};
+
+/// Embree hands the context to filter callbacks, so it carries what the disc filter needs.
+struct TraceContext {
+    RTCIntersectContext embree;  ///< first member: Embree sees a plain RTCIntersectContext
+    const Splats* splats = nullptr;
+    std::uint32_t fromPrim = RTC_INVALID_GEOMETRY_ID;  ///< the disc the ray leaves
+};
+
+/// Overlapping discs of one sheet (neighbours lying near each other's tangent plane) shadow
+/// each other at grazing angles even though the surface they approximate does not: rays
+/// leaving a disc ignore those neighbours. A disc of another layer (a fold) is far off the
+/// tangent plane and still occludes.
+bool isNeighbourDisc(const Splats& splats, std::uint32_t from, std::uint32_t other) {
+    if (from == other) return true;
+    const Vec3 d = splats.centers[other] - splats.centers[from];
+    const float reach = splats.radii[from] + splats.radii[other];
+    if (d.squaredNorm() >= reach * reach) return false;
+    return std::abs(splats.normals[from].dot(d)) < 0.5f * d.norm();  // within 30 degrees
+}
+
+void rejectNeighbourDiscs(const RTCFilterFunctionNArguments* args) {
+    const auto* context = reinterpret_cast<const TraceContext*>(args->context);
+    if (!context->splats || context->fromPrim == RTC_INVALID_GEOMETRY_ID) return;
+    for (unsigned i = 0; i < args->N; ++i) {
+        const std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+        if (args->valid[i] != 0 && isNeighbourDisc(*context->splats, context->fromPrim, prim))
+            args->valid[i] = 0;
+    }
+}
+
+RTCRayHit makeRayHit(const Vec3& origin, const Vec3& direction, float tfar) {
+    RTCRayHit rh;
+    rh.ray.org_x = origin.x();
+    rh.ray.org_y = origin.y();
+    rh.ray.org_z = origin.z();
+    rh.ray.tnear = 0.0f;
+    rh.ray.dir_x = direction.x();
+    rh.ray.dir_y = direction.y();
+    rh.ray.dir_z = direction.z();
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = tfar;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
+/// Both normals face the viewer (two-sided sheets); a shading normal that still points away,
+/// at a silhouette of a smooth-shaded mesh, falls back to the geometric one.
+void orientNormals(SurfaceHit& hit, const Vec3& direction) {
+    if (hit.geometricNormal.dot(direction) > 0.0f) hit.geometricNormal = -hit.geometricNormal;
+    if (hit.shadingNormal.dot(hit.geometricNormal) < 0.0f) hit.shadingNormal = -hit.shadingNormal;
+    if (-hit.shadingNormal.dot(direction) <= 1e-4f) hit.shadingNormal = hit.geometricNormal;
+}
+
+Vec3 safeNormalized(const Vec3& v, const Vec3& fallback) {
+    const float n = v.norm();
+    return n > 1e-20f && std::isfinite(n) ? Vec3(v / n) : fallback;
+}
+
+/// What the path tracer needs from the settings, in float, computed once per frame.
+struct Tracer {
+    RTCScene scene = nullptr;
+    const Mesh* mesh = nullptr;
+    const Splats* splats = nullptr;
+    Vec3 defaultAlbedo;
+    Bsdf material;
+    int maxDepth = 1;
+    float epsilon = 1e-4f;  ///< ray origin offset, relative to the scene's size
+    bool ground = false;
+    float groundZ = 0.0f;
+    Vec3 groundColor;
+    bool sky = true;
+    Vec3 background, zenith, horizon;
+    Vec3 sunDirection;
+    Vec3 sunIrradiance;
+    float sunCosMax = 1.0f;
+    Frame sunFrame{Vec3::UnitZ()};
+
+    Vec3 environment(const Vec3& d) const {
+        if (!sky) return background;
+        const float t = std::clamp(d.z(), 0.0f, 1.0f);
+        return horizon + (zenith - horizon) * t;
+    }
+
+    float groundDistance(const Vec3& origin, const Vec3& direction) const {
+        if (!ground || direction.z() == 0.0f) return std::numeric_limits<float>::infinity();
+        const float t = (groundZ - origin.z()) / direction.z();
+        return t > 0.0f ? t : std::numeric_limits<float>::infinity();
+    }
+
+    TraceContext context(std::uint32_t fromPrim) const {
+        TraceContext c;
+        rtcInitIntersectContext(&c.embree);
+        c.splats = splats;
+        c.fromPrim = fromPrim;
+        return c;
+    }
+
+    bool intersect(const Vec3& origin, const Vec3& direction, std::uint32_t fromPrim,
+                   SurfaceHit& hit, long long& rays) const;
+    void fillSurface(const RTCHit& h, SurfaceHit& hit) const;
+    Vec3 shadowTransmittance(Vec3 origin, const Vec3& direction, std::uint32_t fromPrim,
+                             long long& rays) const;
+    Vec3 sunLight(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& frame, const Vec3& wo,
+                  Sampler& rng, long long& rays) const;
+    Vec3 radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays) const;
+
+    Vec3 spawnOrigin(const SurfaceHit& hit, const Vec3& direction) const {
+        const float side = hit.geometricNormal.dot(direction) >= 0.0f ? 1.0f : -1.0f;
+        return hit.position + side * epsilon * hit.geometricNormal;
+    }
+};
+
+void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
+    const Vec3 ng = safeNormalized(Vec3(h.Ng_x, h.Ng_y, h.Ng_z), Vec3::UnitZ());
+    hit.geometricNormal = ng;
+    if (mesh) {
+        // Embree's (u, v) weight vertices 1 and 2 of the triangle.
+        const auto& tri = mesh->triangles[h.primID];
+        const float w0 = 1.0f - h.u - h.v;
+        const auto& n = mesh->normals;
+        hit.shadingNormal = safeNormalized(w0 * n[tri[0]] + h.u * n[tri[1]] + h.v * n[tri[2]], ng);
+        const auto& c = mesh->colors;
+        hit.albedo =
+            c.empty() ? defaultAlbedo : Vec3(w0 * c[tri[0]] + h.u * c[tri[1]] + h.v * c[tri[2]]);
+    } else {
+        hit.shadingNormal = safeNormalized(splats->normals[h.primID], ng);
+        hit.albedo = splats->colors.empty() ? defaultAlbedo : splats->colors[h.primID];
+    }
+}
+
+bool Tracer::intersect(const Vec3& origin, const Vec3& direction, std::uint32_t fromPrim,
+                       SurfaceHit& hit, long long& rays) const {
+    const float tGround = groundDistance(origin, direction);
+    RTCRayHit rh = makeRayHit(origin, direction, tGround);
+    TraceContext c = context(fromPrim);
+    rtcIntersect1(scene, &c.embree, &rh);
+    ++rays;
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+        hit.t = rh.ray.tfar;
+        fillSurface(rh.hit, hit);
+        hit.ground = false;
+        hit.prim = rh.hit.primID;
+    } else if (std::isfinite(tGround)) {
+        hit.t = tGround;
+        hit.geometricNormal = hit.shadingNormal = Vec3::UnitZ();
+        hit.albedo = groundColor;
+        hit.ground = true;
+    } else {
+        return false;
+    }
+    hit.position = origin + hit.t * direction;
+    orientNormals(hit, direction);
+    return true;
+}
+
+/// How much sunlight reaches along `direction`: 0 or 1 for opaque sheets (one rtcOccluded1),
+/// the product of every film layer's straight-through transmission for film.
+Vec3 Tracer::shadowTransmittance(Vec3 origin, const Vec3& direction, std::uint32_t fromPrim,
+                                 long long& rays) const {
+    if (std::isfinite(groundDistance(origin, direction))) return Vec3::Zero();
+    if (material.kind != MaterialKind::Film) {
+        RTCRay ray = makeRayHit(origin, direction, std::numeric_limits<float>::infinity()).ray;
+        TraceContext c = context(fromPrim);
+        rtcOccluded1(scene, &c.embree, &ray);
+        ++rays;
+        return ray.tfar < 0.0f ? Vec3::Zero() : Vec3::Ones();  // Embree sets tfar = -inf on a hit
+    }
+    Vec3 transmittance = Vec3::Ones();
+    for (int layer = 0; layer < kMaxShadowLayers; ++layer) {
+        SurfaceHit hit;
+        if (!intersect(origin, direction, fromPrim, hit, rays)) return transmittance;
+        Bsdf layerBsdf = material;
+        layerBsdf.albedo = hit.albedo;
+        transmittance = transmittance.cwiseProduct(
+            layerBsdf.straightTransmission(-direction.dot(hit.geometricNormal)));
+        if (maxComponent(transmittance) < 1e-3f) break;
+        origin = spawnOrigin(hit, direction);
+        fromPrim = hit.prim;
+    }
+    return Vec3::Zero();
+}
+
+/// Next-event estimation of the sun, a cone of directions of uniform radiance whose total
+/// irradiance at normal incidence is sunIrradiance: with a uniform cone sample, radiance / pdf
+/// is exactly that irradiance.
+Vec3 Tracer::sunLight(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& frame, const Vec3& wo,
+                      Sampler& rng, long long& rays) const {
+    const auto [u1, u2] = rng.next2D();
+    if (maxComponent(sunIrradiance) <= 0.0f) return Vec3::Zero();
+    const float cosTheta = 1.0f - u1 * (1.0f - sunCosMax);
+    const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
+    const float phi = 2.0f * kPi * u2;
+    const Vec3 wiWorld =
+        sunFrame.toWorld(Vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta));
+    const Vec3 wi = frame.toLocal(wiWorld);
+    // Shading and geometric normals must agree on the side, or light leaks through the sheet.
+    if ((wi.z() > 0.0f) != (hit.geometricNormal.dot(wiWorld) > 0.0f)) return Vec3::Zero();
+    const Vec3 f = bsdf.evalCos(wo, wi);
+    if (maxComponent(f) <= 0.0f) return Vec3::Zero();
+    const Vec3 visible = shadowTransmittance(spawnOrigin(hit, wiWorld), wiWorld, hit.prim, rays);
+    return f.cwiseProduct(visible).cwiseProduct(sunIrradiance);
+}
+
+Vec3 clampContribution(const Vec3& c, int depth) {
+    if (depth == 0) return c;
+    const float m = maxComponent(c);
+    return m > kIndirectClamp ? Vec3(c * (kIndirectClamp / m)) : c;
+}
+
+/// Unidirectional path tracing: the sun by next-event estimation at every vertex, the
+/// environment when a path escapes (the sun is not part of it, so nothing is counted twice).
+Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays) const {
+    Vec3 result = Vec3::Zero();
+    Vec3 throughput = Vec3::Ones();
+    std::uint32_t fromPrim = RTC_INVALID_GEOMETRY_ID;
+    for (int depth = 0;; ++depth) {
+        SurfaceHit hit;
+        if (!intersect(origin, direction, fromPrim, hit, rays)) {
+            result += clampContribution(throughput.cwiseProduct(environment(direction)), depth);
+            break;
+        }
+        if (depth == maxDepth) break;
+        Bsdf bsdf = hit.ground ? Bsdf{MaterialKind::Diffuse, hit.albedo} : material;
+        if (!hit.ground) bsdf.albedo = hit.albedo;
+        const Frame frame(hit.shadingNormal);
+        const Vec3 wo = frame.toLocal(-direction);
+        result += clampContribution(
+            throughput.cwiseProduct(sunLight(hit, bsdf, frame, wo, rng, rays)), depth);
+        Vec3 wi, weight;
+        if (!bsdf.sample(wo, rng, wi, weight)) break;
+        direction = frame.toWorld(wi).normalized();
+        if ((wi.z() > 0.0f) != (hit.geometricNormal.dot(direction) > 0.0f)) break;
+        throughput = throughput.cwiseProduct(weight);
+        if (depth >= kRouletteDepth) {
+            const float survive = std::clamp(maxComponent(throughput), 0.05f, 1.0f);
+            if (rng.next1D() >= survive) break;
+            throughput /= survive;
+        }
+        origin = spawnOrigin(hit, direction);
+        fromPrim = hit.prim;
+    }
+    return result.allFinite() ? result : Vec3::Zero();
+}
+
+// ---- Frame set-up ----------------------------------------------------------------------------
+
+void checkGeometry(const Mesh& mesh) {
+    const std::size_t n = mesh.positions.size();
+    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
+        throw std::invalid_argument("EmbreeRenderer: mesh attribute arrays differ in length");
+    for (const auto& t : mesh.triangles)
+        for (std::uint32_t v : t)
+            if (v >= n) throw std::invalid_argument("EmbreeRenderer: triangle index out of range");
+}
+
+void checkGeometry(const Splats& splats) {
+    const std::size_t n = splats.centers.size();
+    if (splats.normals.size() != n || splats.radii.size() != n ||
+        (!splats.colors.empty() && splats.colors.size() != n))
+        throw std::invalid_argument("EmbreeRenderer: splat attribute arrays differ in length");
+}
+
+/// Largest absolute coordinate of the geometry and the camera: the scale of float round-off.
+float sceneScale(const Geometry& geometry, const RenderSettings& s) {
+    float scale = std::max(1.0f, float(s.camera.position.cwiseAbs().maxCoeff()));
+    const auto& points = std::holds_alternative<Mesh>(geometry)
+                             ? std::get<Mesh>(geometry).positions
+                             : std::get<Splats>(geometry).centers;
+    for (const Vec3& p : points) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+    return scale;
+}
+
+Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
+    const PathTracing& pt = s.pathTracing;
+    Tracer tr;
+    tr.defaultAlbedo = toFloat(s.albedo);
+    tr.material.kind = pt.material;
+    tr.material.alpha = std::max(kMinAlpha, float(pt.roughness * pt.roughness));
+    tr.material.transmission = std::clamp(float(pt.transmission), 0.0f, 1.0f);
+    tr.maxDepth = std::max(1, pt.maxDepth);
+    tr.epsilon = 1e-4f * sceneScale(geometry, s);
+    tr.ground = s.ground;
+    tr.groundZ = float(s.groundHeight);
+    tr.groundColor = toFloat(s.groundColor);
+    tr.sky = pt.sky;
+    tr.background = toFloat(s.background);
+    tr.zenith = toFloat(pt.skyZenith);
+    tr.horizon = toFloat(pt.skyHorizon);
+    tr.sunDirection = safeNormalized(toFloat(s.sun.direction), Vec3::UnitZ());
+    // Irradiance pi * colour * intensity: a white Lambert sheet facing the sun then reflects
+    // radiance colour * intensity, the same brightness the OSMesa preview gives it.
+    tr.sunIrradiance = toFloat(std::numbers::pi * s.sun.color * s.sun.intensity).cwiseMax(0.0f);
+    const double radius = std::clamp(pt.sunAngularRadiusDegrees, 0.0, 90.0);
+    tr.sunCosMax = float(std::cos(radius * std::numbers::pi / 180.0));
+    tr.sunFrame = Frame(tr.sunDirection);
+    if (const Mesh* m = std::get_if<Mesh>(&geometry))
+        tr.mesh = m;
+    else
+        tr.splats = &std::get<Splats>(geometry);
+    return tr;
+}
+
+struct CameraRays {
+    Vec3 origin;
+    detail::ViewBasis basis;
+    double fovY = 40.0;
+    double aspect = 1.0;
+    int width = 1;
+    int height = 1;
+
+    Vec3 direction(int x, int y, float jx, float jy) const {
+        const double ndcX = 2.0 * (x + jx) / width - 1.0;
+        const double ndcY = 1.0 - 2.0 * (y + jy) / height;  // image rows run top-down
+        return detail::cameraRayDirection(basis, fovY, aspect, ndcX, ndcY)
+            .normalized()
+            .cast<float>();
+    }
+};
+
+std::uint8_t encode(double linear) {
+    const double c = std::pow(std::clamp(linear, 0.0, 1.0), 1.0 / kGamma);
+    return static_cast<std::uint8_t>(std::lround(c * 255.0));
+}
+
+}  // namespace
+
+// ---- Embree device and scene -----------------------------------------------------------------
+
+struct EmbreeRenderer::Impl {
+    enum class Kind { None, Mesh, Splats };
+
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    RTCGeometry geometry = nullptr;  ///< owned by the scene; kept to update its buffers
+    Kind kind = Kind::None;
+    std::size_t vertexCount = 0;
+    std::vector<std::array<std::uint32_t, 3>> triangles;  ///< the last frame's topology
+    float* vertices = nullptr;                            ///< Embree-owned buffers of `geometry`
+    float* normals = nullptr;
+    std::string lastError;
+    long long rays = 0;
+
+    ~Impl();
+    void check(const char* what);
+    void upload(const Geometry& geometry);
+    bool sameTopology(const Geometry& geometry) const;
+    void rebuild(const Geometry& geometry);
+    void createMesh(const Mesh& mesh);
+    void createSplats(const Splats& splats);
+    void copyVertices(const Geometry& geometry);
+    void refit();
+    Image trace(const Tracer& tracer, const CameraRays& camera, int spp);
+    long long traceTile(const Tracer& tracer, const CameraRays& camera, int spp, int tile,
+                        std::vector<std::uint8_t>& rgb) const;
+};
+
+EmbreeRenderer::Impl::~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+}
+
+void EmbreeRenderer::Impl::check(const char* what) {
+    const RTCError code = rtcGetDeviceError(device);
+    if (code == RTC_ERROR_NONE) return;
+    throw std::runtime_error(
+        std::string("EmbreeRenderer: ") + what +
+        " failed: " + (lastError.empty() ? "error " + std::to_string(int(code)) : lastError));
+}
+
+bool EmbreeRenderer::Impl::sameTopology(const Geometry& g) const {
+    if (const Mesh* mesh = std::get_if<Mesh>(&g))
+        return kind == Kind::Mesh && mesh->positions.size() == vertexCount &&
+               mesh->triangles == triangles;
+    return kind == Kind::Splats && std::get<Splats>(g).centers.size() == vertexCount;
+}
+
+void EmbreeRenderer::Impl::upload(const Geometry& g) {
+    if (geometry && sameTopology(g)) {
+        copyVertices(g);
+        refit();
+    } else {
+        rebuild(g);
+    }
+}
+
+void EmbreeRenderer::Impl::rebuild(const Geometry& g) {
+    if (scene) rtcReleaseScene(scene);
+    geometry = nullptr;
+    kind = Kind::None;
+    vertexCount = 0;
+    triangles.clear();
+    scene = rtcNewScene(device);
+    // Dynamic: rebuilt or refitted every frame. Robust: watertight shared edges, so no sunlight
+    // leaks through the seams of a closed sheet.
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+    if (const Mesh* mesh = std::get_if<Mesh>(&g)) {
+        if (!mesh->triangles.empty()) createMesh(*mesh);
+    } else if (!std::get<Splats>(g).centers.empty()) {
+        createSplats(std::get<Splats>(g));
+    }
+    rtcCommitScene(scene);
+    check("building the BVH");
+}
+
+void EmbreeRenderer::Impl::createMesh(const Mesh& mesh) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    check("creating a triangle geometry");
+    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
+    vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), mesh.positions.size()));
+    auto* index = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(std::uint32_t), mesh.triangles.size()));
+    check("allocating triangle buffers");
+    std::memcpy(index, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(std::uint32_t));
+    kind = Kind::Mesh;
+    vertexCount = mesh.positions.size();
+    triangles = mesh.triangles;
+    geometry = geom;
+    copyVertices(mesh);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);  // the scene holds the reference now
+}
+
+void EmbreeRenderer::Impl::createSplats(const Splats& splats) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+    check("creating an oriented-disc geometry");
+    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
+    rtcSetGeometryIntersectFilterFunction(geom, rejectNeighbourDiscs);
+    rtcSetGeometryOccludedFilterFunction(geom, rejectNeighbourDiscs);
+    const std::size_t n = splats.centers.size();
+    vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+    normals = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0,
+                                                          RTC_FORMAT_FLOAT3, sizeof(Vec3), n));
+    check("allocating disc buffers");
+    kind = Kind::Splats;
+    vertexCount = n;
+    geometry = geom;
+    copyVertices(splats);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+}
+
+void EmbreeRenderer::Impl::copyVertices(const Geometry& g) {
+    if (const Mesh* mesh = std::get_if<Mesh>(&g)) {
+        std::memcpy(vertices, mesh->positions.data(), mesh->positions.size() * sizeof(Vec3));
+        return;
+    }
+    const Splats& splats = std::get<Splats>(g);
+    for (std::size_t i = 0; i < splats.centers.size(); ++i) {
+        float* v = vertices + 4 * i;
+        v[0] = splats.centers[i].x();
+        v[1] = splats.centers[i].y();
+        v[2] = splats.centers[i].z();
+        v[3] = splats.radii[i];
+    }
+    std::memcpy(normals, splats.normals.data(), splats.normals.size() * sizeof(Vec3));
+}
+
+void EmbreeRenderer::Impl::refit() {
+    rtcUpdateGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+    if (kind == Kind::Splats) rtcUpdateGeometryBuffer(geometry, RTC_BUFFER_TYPE_NORMAL, 0);
+    // Same topology: moving the existing BVH's boxes is far cheaper than a rebuild.
+    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
+    rtcCommitGeometry(geometry);
+    rtcCommitScene(scene);
+    check("refitting the BVH");
+}
+
+long long EmbreeRenderer::Impl::traceTile(const Tracer& tracer, const CameraRays& camera, int spp,
+                                          int tile, std::vector<std::uint8_t>& rgb) const {
+    const int tilesX = (camera.width + kTileSize - 1) / kTileSize;
+    const int x0 = (tile % tilesX) * kTileSize;
+    const int y0 = (tile / tilesX) * kTileSize;
+    long long rays = 0;
+    for (int y = y0; y < std::min(y0 + kTileSize, camera.height); ++y) {
+        for (int x = x0; x < std::min(x0 + kTileSize, camera.width); ++x) {
+            const std::size_t pixel = std::size_t(y) * camera.width + x;
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+            for (int s = 0; s < spp; ++s) {
+                Sampler rng(pixel, std::uint32_t(s), std::uint32_t(spp));
+                const auto [jx, jy] = rng.next2D();
+                const Vec3 d = camera.direction(x, y, jx, jy);
+                sum += tracer.radiance(camera.origin, d, rng, rays).cast<double>();
+            }
+            for (int k = 0; k < 3; ++k) rgb[pixel * 3 + k] = encode(sum[k] / spp);
+        }
+    }
+    return rays;
+}
+
+Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera, int spp) {
+    Image image{camera.width, camera.height,
+                std::vector<std::uint8_t>(std::size_t(camera.width) * camera.height * 3)};
+    const int tiles = ((camera.width + kTileSize - 1) / kTileSize) *
+                      ((camera.height + kTileSize - 1) / kTileSize);
+    long long total = 0;
+    // Each pixel's random numbers depend on (pixel, sample, dimension) only, so the dynamic
+    // tile order cannot change a byte, and the integer ray count sums exactly.
+#pragma omp parallel for schedule(dynamic) reduction(+ : total)
+    for (int tile = 0; tile < tiles; ++tile)
+        total += traceTile(tracer, camera, spp, tile, image.rgb);
+    rays = total;
+    return image;
+}
+
+// ---- Public interface ------------------------------------------------------------------------
+
+EmbreeRenderer::EmbreeRenderer() : impl_(std::make_unique<Impl>()) {
+    impl_->device = rtcNewDevice(nullptr);
+    if (!impl_->device)
+        throw std::runtime_error("EmbreeRenderer: rtcNewDevice failed (error " +
+                                 std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(
+        impl_->device,
+        [](void* user, RTCError, const char* message) {
+            static_cast<Impl*>(user)->lastError = message ? message : "";
+        },
+        impl_.get());
+    if (!rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_POINT_GEOMETRY_SUPPORTED) ||
+        !rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED))
+        throw std::runtime_error(
+            "EmbreeRenderer: this Embree was built without point geometry or filter functions");
+}
+
+EmbreeRenderer::~EmbreeRenderer() = default;
+
+Image EmbreeRenderer::render(const Geometry& geometry, const RenderSettings& settings) {
+    if (settings.width <= 0 || settings.height <= 0)
+        throw std::invalid_argument("EmbreeRenderer: image size must be positive");
+    std::visit([](const auto& g) { checkGeometry(g); }, geometry);
+    impl_->upload(geometry);
+    Tracer tracer = makeTracer(geometry, settings);
+    tracer.scene = impl_->scene;
+    CameraRays camera;
+    camera.origin = toFloat(settings.camera.position);
+    camera.basis =
+        detail::viewBasis(settings.camera.position, settings.camera.lookAt, settings.camera.up);
+    camera.fovY = settings.camera.fovYDegrees;
+    camera.aspect = double(settings.width) / settings.height;
+    camera.width = settings.width;
+    camera.height = settings.height;
+    return impl_->trace(tracer, camera, std::max(1, settings.pathTracing.samplesPerPixel));
+}
+
+std::string EmbreeRenderer::deviceDescription() {
+    auto property = [&](RTCDeviceProperty p) {
+        return std::to_string(rtcGetDeviceProperty(impl_->device, p));
+    };
+    return "Embree " + property(RTC_DEVICE_PROPERTY_VERSION_MAJOR) + "." +
+           property(RTC_DEVICE_PROPERTY_VERSION_MINOR) + "." +
+           property(RTC_DEVICE_PROPERTY_VERSION_PATCH);
+}
+
+long long EmbreeRenderer::raysTraced() const { return impl_->rays; }
+
+}  // namespace rend::render

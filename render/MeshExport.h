@@ -1,0 +1,32 @@
+#pragma once
+// Writes a render Mesh to a file another tool can open: binary PLY (point-cloud and geometry
+// tools), OBJ + MTL (everything), GLB (web viewers, Blender). OBJ and GLB go through assimp;
+// binary PLY is written directly because assimp 5.2's binary PLY exporter corrupts files that
+// have vertex colours (see MeshExport.cpp).
+
+#include <filesystem>
+#include <string_view>
+
+#include "render/Mesh.h"
+
+namespace rend::render {
+
+enum class MeshFormat { Ply, Obj, Glb };
+
+/// "ply", "obj" or "glb" (case-insensitive, an optional leading dot allowed); throws
+/// std::invalid_argument naming the accepted values otherwise.
+MeshFormat parseMeshFormat(std::string_view name);
+
+/// The usual file extension of a format, with the dot (".ply", ".obj", ".glb").
+std::string_view meshFormatExtension(MeshFormat format);
+
+/// Writes positions, triangles, per-vertex normals and colours: GLB as linear COLOR_0 (glTF's
+/// convention), PLY as 8-bit red/green/blue encoded with gamma 1/2.2 (viewers show PLY bytes
+/// as sRGB), OBJ only as the non-standard "v x y z r g b" extension. Every file (OBJ's .mtl too) is
+/// first written into the folder `path` + ".tmp" and then renamed next to `path`, the main file
+/// last, so a reader never sees a half-written file nor an OBJ whose material library is missing.
+/// Throws std::runtime_error (with assimp's error string where assimp failed), leaving nothing
+/// behind.
+void exportMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format);
+
+}  // namespace rend::render

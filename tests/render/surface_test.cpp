@@ -1,0 +1,658 @@
+// Tests for the splat, vdb and extruded lattice surfaces and for mesh export (ply, obj, glb).
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "render/ColorMap.h"
+#include "render/LatticeSurface.h"
+#include "render/MeshExport.h"
+#include "render/SplatSurface.h"
+#include "render/VdbSurface.h"
+#include "sim/FrameView.h"
+#include "sim/Membrane.h"
+
+namespace fs = std::filesystem;
+using rend::render::ColorBy;
+using rend::render::LatticeSurface;
+using rend::render::Mesh;
+using rend::render::MeshFormat;
+using rend::render::RenderSettings;
+using rend::render::SplatSurface;
+using rend::render::VdbSettings;
+using rend::render::VdbSurface;
+using rend::sim::FrameView;
+
+namespace {
+
+constexpr double kDx = 0.02;
+
+// A hexagonal sheet from the simulator's public API, copied into arrays the tests own so they
+// can move particles and break bonds freely without touching the solver.
+struct Frame {
+    std::vector<Eigen::Vector3d> positions, velocities, rest;
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<int> offsets, partners;
+    std::vector<double> restLength;
+    std::vector<std::uint8_t> alive;
+
+    explicit Frame(double sizeX, double sizeY) {
+        rend::sim::MembraneParams params;
+        params.sheet.size = {sizeX, sizeY};
+        params.sheet.dx = kDx;
+        const rend::sim::Membrane membrane(params);
+        const FrameView v = membrane.view(1);
+        positions.assign(v.positions.begin(), v.positions.end());
+        velocities.assign(v.velocities.begin(), v.velocities.end());
+        rest.assign(v.restPositions.begin(), v.restPositions.end());
+        triangles.assign(v.restTriangles.begin(), v.restTriangles.end());
+        offsets.assign(v.bondOffsets.begin(), v.bondOffsets.end());
+        partners.assign(v.bondPartners.begin(), v.bondPartners.end());
+        restLength.assign(v.bondRestLength.begin(), v.bondRestLength.end());
+        alive.assign(v.bondAlive.begin(), v.bondAlive.end());
+    }
+
+    int size() const { return int(positions.size()); }
+
+    FrameView view() const {
+        FrameView v;
+        v.frame = 1;
+        v.positions = positions;
+        v.velocities = velocities;
+        v.restPositions = rest;
+        v.restTriangles = triangles;
+        v.bondOffsets = offsets;
+        v.bondPartners = partners;
+        v.bondRestLength = restLength;
+        v.bondAlive = alive;
+        return v;
+    }
+
+    void breakBond(int a, int b) {
+        const FrameView v = view();
+        const int ab = v.findBond(a, b);
+        const int ba = v.findBond(b, a);
+        if (ab >= 0) alive[ab] = 0;
+        if (ba >= 0) alive[ba] = 0;
+    }
+
+    // The interior particle nearest the rest point (x, y).
+    int nearest(double x, double y) const {
+        int best = 0;
+        for (int i = 1; i < size(); ++i)
+            if ((rest[i].head<2>() - Eigen::Vector2d(x, y)).norm() <
+                (rest[best].head<2>() - Eigen::Vector2d(x, y)).norm())
+                best = i;
+        return best;
+    }
+};
+
+// z = A sin(k x): a wavy sheet with a known normal everywhere.
+constexpr double kWaveAmplitude = 0.02;
+constexpr double kWaveNumber = 2.0 * std::numbers::pi / 0.3;
+
+void makeWavy(Frame& frame) {
+    for (int i = 0; i < frame.size(); ++i)
+        frame.positions[i].z() = kWaveAmplitude * std::sin(kWaveNumber * frame.rest[i].x());
+}
+
+Eigen::Vector3d waveNormal(double x) {
+    return Eigen::Vector3d(-kWaveAmplitude * kWaveNumber * std::cos(kWaveNumber * x), 0.0, 1.0)
+        .normalized();
+}
+
+double angleDegrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 /
+           std::numbers::pi;
+}
+
+fs::path scratchDir(const std::string& name) {
+    const fs::path dir = fs::path(::testing::TempDir()) / "rend_surface_tests" / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+bool anyTmpLeft(const fs::path& dir) {
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.path().string().ends_with(".tmp")) return true;
+    return false;
+}
+
+// ---- mesh topology -------------------------------------------------------------------------
+
+using Edge = std::pair<std::uint32_t, std::uint32_t>;
+
+std::map<Edge, int> undirectedEdgeUse(const Mesh& mesh) {
+    std::map<Edge, int> use;
+    for (const auto& t : mesh.triangles)
+        for (int e = 0; e < 3; ++e) ++use[std::minmax(t[e], t[(e + 1) % 3])];
+    return use;
+}
+
+// Every edge shared by exactly two triangles, walked once in each direction: a closed,
+// consistently oriented surface.
+bool isClosedAndOriented(const Mesh& mesh) {
+    std::map<Edge, int> directed;
+    for (const auto& t : mesh.triangles)
+        for (int e = 0; e < 3; ++e) ++directed[{t[e], t[(e + 1) % 3]}];
+    for (const auto& [edge, count] : directed) {
+        const auto reverse = directed.find({edge.second, edge.first});
+        if (count != 1 || reverse == directed.end() || reverse->second != 1) return false;
+    }
+    return !mesh.triangles.empty();
+}
+
+int referencedVertexCount(const Mesh& mesh) {
+    std::set<std::uint32_t> used;
+    for (const auto& t : mesh.triangles) used.insert(t.begin(), t.end());
+    return int(used.size());
+}
+
+int eulerCharacteristic(const Mesh& mesh) {
+    return referencedVertexCount(mesh) - int(undirectedEdgeUse(mesh).size()) +
+           int(mesh.triangles.size());
+}
+
+int componentCount(const Mesh& mesh) {
+    std::vector<std::uint32_t> parent(mesh.positions.size());
+    for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+    auto find = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const auto& t : mesh.triangles) {
+        parent[find(t[1])] = find(t[0]);
+        parent[find(t[2])] = find(t[0]);
+    }
+    std::set<std::uint32_t> roots;
+    for (const auto& t : mesh.triangles) roots.insert(find(t[0]));
+    return int(roots.size());
+}
+
+// Merges vertices with bit-identical positions (the extruded lattice's wall vertices are exact
+// copies of the face vertices).
+Mesh weldByPosition(const Mesh& mesh) {
+    std::map<std::tuple<float, float, float>, std::uint32_t> index;
+    std::vector<std::uint32_t> remap(mesh.positions.size());
+    Mesh welded;
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const auto& p = mesh.positions[v];
+        const auto [it, inserted] =
+            index.try_emplace({p.x(), p.y(), p.z()}, std::uint32_t(welded.positions.size()));
+        if (inserted) welded.positions.push_back(p);
+        remap[v] = it->second;
+    }
+    for (const auto& t : mesh.triangles)
+        welded.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+    return welded;
+}
+
+void expectWellFormed(const Mesh& mesh) {
+    ASSERT_EQ(mesh.positions.size(), mesh.normals.size());
+    ASSERT_EQ(mesh.positions.size(), mesh.colors.size());
+    for (const auto& t : mesh.triangles)
+        for (auto v : t) ASSERT_LT(v, mesh.positions.size());
+    for (const auto& n : mesh.normals) ASSERT_NEAR(n.norm(), 1.0f, 1e-4f);
+}
+
+}  // namespace
+
+// ---- SplatSurface ----------------------------------------------------------------------------
+
+TEST(SplatSurface, FlatSheetGetsOneOverlappingUpwardDiscPerParticle) {
+    const Frame frame(0.3, 0.2);
+    const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
+    ASSERT_EQ(int(splats.centers.size()), frame.size());
+    ASSERT_EQ(splats.normals.size(), splats.centers.size());
+    ASSERT_EQ(splats.colors.size(), splats.centers.size());
+    ASSERT_EQ(splats.radii.size(), splats.centers.size());
+    for (int i = 0; i < frame.size(); ++i) {
+        // Neighbours are dx apart, so radii above dx / 2 overlap.
+        EXPECT_GT(splats.radii[i], 0.5 * kDx);
+        EXPECT_NEAR(splats.normals[i].norm(), 1.0f, 1e-5f);
+        EXPECT_GT(splats.normals[i].z(), 0.9999f) << "particle " << i;
+        EXPECT_TRUE(splats.centers[i].isApprox(frame.positions[i].cast<float>()));
+    }
+}
+
+TEST(SplatSurface, RadiusCoversTheHexagonalLattice) {
+    // The plane is covered when the radius reaches the triangles' circumradius dx / sqrt(3).
+    const Frame frame(0.2, 0.2);
+    EXPECT_GT(SplatSurface(frame.view()).radius(), kDx / std::sqrt(3.0));
+    EXPECT_NEAR(rend::render::restSpacing(frame.view()), kDx, 1e-9);
+}
+
+TEST(SplatSurface, NormalsFollowAWavySheet) {
+    Frame frame(0.6, 0.3);
+    makeWavy(frame);
+    const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
+    double worst = 0.0;
+    for (int i = 0; i < frame.size(); ++i)
+        worst = std::max(
+            worst, angleDegrees(splats.normals[i].cast<double>(), waveNormal(frame.rest[i].x())));
+    EXPECT_LT(worst, 10.0);
+}
+
+TEST(SplatSurface, NormalsStayOnTheRestUpperSideWhenTheSheetIsTurnedOver) {
+    // Rotated by pi about x: the side that faced +z at rest now faces -z, and every normal
+    // must say so (no per-particle flip towards +z).
+    Frame frame(0.3, 0.2);
+    for (auto& p : frame.positions) p = Eigen::Vector3d(p.x(), -p.y(), -p.z() + 0.1);
+    const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
+    for (const auto& n : splats.normals) EXPECT_LT(n.z(), -0.9999f);
+}
+
+TEST(SplatSurface, ParticleWithoutTrianglesFallsBackToItsNeighbourPlane) {
+    Frame frame(0.6, 0.3);
+    makeWavy(frame);
+    const SplatSurface surface(frame.view());
+    // Break the outer ring of the particle's star: its triangles all go, its bonds stay.
+    const int p = frame.nearest(0.04, 0.0);
+    for (const auto& t : frame.triangles) {
+        if (std::find(t.begin(), t.end(), p) == t.end()) continue;
+        for (int e = 0; e < 3; ++e)
+            if (t[e] != p && t[(e + 1) % 3] != p) frame.breakBond(t[e], t[(e + 1) % 3]);
+    }
+    const auto splats = surface.build(frame.view(), RenderSettings{});
+    const Eigen::Vector3d expected = waveNormal(frame.rest[p].x());
+    EXPECT_LT(angleDegrees(splats.normals[p].cast<double>(), expected), 10.0);
+    // And the same way up when the whole sheet is turned over.
+    for (auto& x : frame.positions) x = Eigen::Vector3d(x.x(), -x.y(), -x.z());
+    const auto turned = surface.build(frame.view(), RenderSettings{});
+    const Eigen::Vector3d turnedExpected(expected.x(), -expected.y(), -expected.z());
+    EXPECT_LT(angleDegrees(turned.normals[p].cast<double>(), turnedExpected), 10.0);
+}
+
+TEST(SplatSurface, IsolatedParticlePointsUp) {
+    Frame frame(0.2, 0.2);
+    const SplatSurface surface(frame.view());
+    const int p = frame.nearest(0.0, 0.0);
+    for (int b = frame.offsets[p]; b < frame.offsets[p + 1]; ++b)
+        frame.breakBond(p, frame.partners[b]);
+    for (auto& x : frame.positions) x = Eigen::Vector3d(x.x(), -x.y(), -x.z());
+    const auto splats = surface.build(frame.view(), RenderSettings{});
+    EXPECT_TRUE(splats.normals[p].isApprox(Eigen::Vector3f::UnitZ()));
+}
+
+TEST(SplatSurface, ColoursComeFromTheColourMap) {
+    Frame frame(0.2, 0.2);
+    for (int i = 0; i < frame.size(); ++i) frame.velocities[i] = Eigen::Vector3d(i, 0.0, 0.0);
+    RenderSettings settings;
+    settings.colorBy = ColorBy::Speed;
+    const auto splats = SplatSurface(frame.view()).build(frame.view(), settings);
+    EXPECT_EQ(splats.colors, rend::render::particleColors(frame.view(), settings));
+}
+
+TEST(SplatSurface, RestWithoutBondsOrTrianglesIsRefused) {
+    const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}};
+    FrameView v;
+    v.positions = points;
+    v.restPositions = points;
+    EXPECT_THROW(SplatSurface{v}, std::invalid_argument);
+}
+
+TEST(SplatSurface, MeshHasAFanPerDiscFacingItsNormal) {
+    Frame frame(0.2, 0.2);
+    makeWavy(frame);
+    const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
+    constexpr int kSegments = 6;
+    const Mesh mesh = rend::render::splatsToMesh(splats, kSegments);
+    expectWellFormed(mesh);
+    ASSERT_EQ(mesh.positions.size(), splats.centers.size() * (kSegments + 1));
+    ASSERT_EQ(mesh.triangles.size(), splats.centers.size() * kSegments);
+    const float rim = splats.radii[0] / std::cos(std::numbers::pi_v<float> / kSegments);
+    for (std::size_t d = 0; d < splats.centers.size(); ++d) {
+        EXPECT_TRUE(mesh.positions[d * (kSegments + 1)].isApprox(splats.centers[d]));
+        EXPECT_NEAR((mesh.positions[d * (kSegments + 1) + 1] - splats.centers[d]).norm(), rim,
+                    1e-5f);
+        for (int k = 0; k < kSegments; ++k) {
+            const auto& t = mesh.triangles[d * kSegments + k];
+            const Eigen::Vector3f n = (mesh.positions[t[1]] - mesh.positions[t[0]])
+                                          .cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
+            EXPECT_GT(n.normalized().dot(splats.normals[d]), 0.9999f);
+        }
+    }
+    EXPECT_THROW(rend::render::splatsToMesh(splats, 2), std::invalid_argument);
+}
+
+// ---- VdbSurface ------------------------------------------------------------------------------
+
+namespace {
+
+void expectOneClosedPillow(const Mesh& mesh) {
+    expectWellFormed(mesh);
+    EXPECT_EQ(componentCount(mesh), 1);
+    EXPECT_TRUE(isClosedAndOriented(mesh));
+    EXPECT_EQ(eulerCharacteristic(mesh), 2);  // a sphere: no hole through the sheet
+}
+
+}  // namespace
+
+TEST(VdbSurface, FlatSheetIsOneClosedPillowWithoutHoles) {
+    const Frame frame(0.3, 0.2);
+    VdbSurface surface(frame.view(), VdbSettings{});
+    EXPECT_NEAR(surface.voxelSize(), 0.5 * kDx, 1e-12);
+    EXPECT_NEAR(surface.particleRadius(), 0.75 * kDx, 1e-12);
+    const Mesh mesh = surface.build(frame.view(), RenderSettings{});
+    EXPECT_EQ(surface.droppedParticles(), 0);
+    expectOneClosedPillow(mesh);
+    // Outward normals: up on the upper face, down on the lower one.
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const auto& p = mesh.positions[v];
+        if (std::abs(p.x()) > 0.1f || std::abs(p.y()) > 0.05f) continue;  // interior only
+        if (p.z() > 0.5f * kDx) {
+            EXPECT_GT(mesh.normals[v].z(), 0.5f);
+        } else if (p.z() < -0.5f * kDx) {
+            EXPECT_LT(mesh.normals[v].z(), -0.5f);
+        }
+    }
+}
+
+TEST(VdbSurface, SmoothingKeepsAThinSheetIntact) {
+    Frame frame(0.6, 0.3);
+    makeWavy(frame);
+    for (int iterations : {0, 2, 4}) {
+        SCOPED_TRACE(iterations);
+        VdbSettings settings;
+        settings.smoothingIterations = iterations;
+        VdbSurface surface(frame.view(), settings);
+        expectOneClosedPillow(surface.build(frame.view(), RenderSettings{}));
+        EXPECT_EQ(surface.droppedParticles(), 0);
+    }
+}
+
+TEST(VdbSurface, SmoothingKeepsTheFlatPillowAboutOneAndAHalfDxThick) {
+    const Frame frame(0.3, 0.2);
+    for (int iterations : {0, 1, 2, 4}) {
+        SCOPED_TRACE(iterations);
+        VdbSettings settings;
+        settings.smoothingIterations = iterations;
+        const Mesh mesh = VdbSurface(frame.view(), settings).build(frame.view(), RenderSettings{});
+        float top = -1.0f, bottom = 1.0f;
+        for (const auto& p : mesh.positions) {
+            top = std::max(top, p.z());
+            bottom = std::min(bottom, p.z());
+        }
+        EXPECT_GT(top - bottom, 1.2 * kDx);
+        EXPECT_LT(top - bottom, 1.6 * kDx);
+        EXPECT_NEAR(top + bottom, 0.0f, 0.05 * kDx);
+    }
+}
+
+TEST(VdbSurface, SheetWithAHoleHasEulerCharacteristicZero) {
+    // Checks the hole detector above: without the particles near the centre the pillow is a
+    // torus.
+    const Frame frame(0.3, 0.2);
+    std::vector<Eigen::Vector3d> kept;
+    for (const auto& p : frame.positions)
+        if (p.head<2>().norm() > 2.5 * kDx) kept.push_back(p);
+    const std::vector<Eigen::Vector3d> still(kept.size(), Eigen::Vector3d::Zero());
+    FrameView holed;
+    holed.positions = kept;
+    holed.velocities = still;
+    VdbSurface surface(frame.view(), VdbSettings{});
+    const Mesh mesh = surface.build(holed, RenderSettings{});
+    EXPECT_EQ(componentCount(mesh), 1);
+    EXPECT_TRUE(isClosedAndOriented(mesh));
+    EXPECT_EQ(eulerCharacteristic(mesh), 0);
+}
+
+TEST(VdbSurface, SheetCutInTwoGivesTwoComponents) {
+    Frame frame(0.3, 0.2);
+    VdbSurface surface(frame.view(), VdbSettings{});
+    for (int i = 0; i < frame.size(); ++i)
+        if (frame.rest[i].x() > 0.0) frame.positions[i].x() += 10.0 * kDx;
+    const Mesh mesh = surface.build(frame.view(), RenderSettings{});
+    EXPECT_EQ(componentCount(mesh), 2);
+    EXPECT_TRUE(isClosedAndOriented(mesh));
+}
+
+TEST(VdbSurface, VerticesTakeTheColourOfTheNearestParticle) {
+    Frame frame(0.3, 0.2);
+    for (int i = 0; i < frame.size(); ++i)
+        frame.velocities[i] = Eigen::Vector3d(frame.rest[i].x() > 0.0 ? 1.0 : 0.0, 0.0, 0.0);
+    RenderSettings settings;
+    settings.colorBy = ColorBy::Speed;
+    VdbSurface surface(frame.view(), VdbSettings{});
+    const Mesh mesh = surface.build(frame.view(), settings);
+    const Eigen::Vector3f slow = rend::render::colormap(0.0);
+    const Eigen::Vector3f fast = rend::render::colormap(1.0);
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        if (mesh.positions[v].x() > 2 * kDx) {
+            EXPECT_TRUE(mesh.colors[v].isApprox(fast));
+        } else if (mesh.positions[v].x() < -2 * kDx) {
+            EXPECT_TRUE(mesh.colors[v].isApprox(slow));
+        }
+    }
+}
+
+TEST(VdbSurface, WrittenGridReadsBackWithTheSameActiveVoxels) {
+    const Frame frame(0.3, 0.2);
+    VdbSurface surface(frame.view(), VdbSettings{});
+    EXPECT_THROW(surface.writeVdb(scratchDir("early") / "x.vdb"), std::logic_error);
+    surface.build(frame.view(), RenderSettings{});
+    const fs::path dir = scratchDir("vdb");
+    surface.writeVdb(dir / "frame_0001.vdb");
+    const auto info = rend::render::inspectVdb(dir / "frame_0001.vdb");
+    EXPECT_EQ(info.gridCount, 1u);
+    EXPECT_EQ(info.firstGridName, "surface");
+    EXPECT_GT(surface.activeVoxelCount(), 0u);
+    EXPECT_EQ(info.firstGridActiveVoxels, surface.activeVoxelCount());
+    EXPECT_NEAR(info.firstGridVoxelSize, surface.voxelSize(), 1e-12);
+    EXPECT_FALSE(anyTmpLeft(dir));
+}
+
+TEST(VdbSurface, RadiusBelowOneAndAHalfVoxelsIsRefused) {
+    const Frame frame(0.2, 0.2);
+    VdbSettings settings;
+    settings.voxelSize = 0.01;
+    settings.particleRadius = 0.0149;
+    EXPECT_THROW(VdbSurface(frame.view(), settings), std::invalid_argument);
+    settings.voxelSize = 0.0;  // dx / 2 = 0.01 again, from the rest spacing
+    EXPECT_THROW(VdbSurface(frame.view(), settings), std::invalid_argument);
+    // Exactly 1.5 voxels is the smallest OpenVDB keeps: accepted, and nothing dropped.
+    settings.particleRadius = 0.015;
+    VdbSurface edge(frame.view(), settings);
+    edge.build(frame.view(), RenderSettings{});
+    EXPECT_EQ(edge.droppedParticles(), 0);
+}
+
+// ---- LatticeSurface thickness ----------------------------------------------------------------
+
+TEST(LatticeThickness, ZeroThicknessIsTheSheet) {
+    const Frame frame(0.2, 0.2);
+    const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), RenderSettings{});
+    EXPECT_EQ(int(mesh.positions.size()), frame.size());
+    EXPECT_EQ(mesh.triangles.size(), frame.triangles.size());
+}
+
+TEST(LatticeThickness, ExtrudedIntactSheetIsAClosedSlab) {
+    const Frame frame(0.3, 0.2);
+    RenderSettings settings;
+    settings.thickness = 0.004;
+    const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), settings);
+    expectWellFormed(mesh);
+    // Top face keeps the particle indices, offset by half the thickness.
+    for (int i = 0; i < frame.size(); ++i) EXPECT_NEAR(mesh.positions[i].z(), 0.002f, 1e-7f);
+    const Mesh welded = weldByPosition(mesh);
+    EXPECT_TRUE(isClosedAndOriented(welded));
+    EXPECT_EQ(eulerCharacteristic(welded), 2);
+    EXPECT_EQ(componentCount(welded), 1);
+}
+
+TEST(LatticeThickness, CrackGetsWallsOnBothLips) {
+    Frame frame(0.3, 0.2);
+    const LatticeSurface surface(frame.view());
+    // Cut every bond crossing x = 0.005: two closed slabs.
+    for (int i = 0; i < frame.size(); ++i)
+        for (int b = frame.offsets[i]; b < frame.offsets[i + 1]; ++b)
+            if ((frame.rest[i].x() < 0.005) != (frame.rest[frame.partners[b]].x() < 0.005))
+                frame.breakBond(i, frame.partners[b]);
+    RenderSettings settings;
+    settings.thickness = 0.004;
+    const Mesh welded = weldByPosition(surface.build(frame.view(), settings));
+    EXPECT_TRUE(isClosedAndOriented(welded));
+    EXPECT_EQ(componentCount(welded), 2);
+}
+
+// ---- Mesh export -----------------------------------------------------------------------------
+
+namespace {
+
+// A 4 x 3 vertex grid in z = 0 with a different colour per vertex.
+Mesh colouredGrid() {
+    Mesh mesh;
+    for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            mesh.positions.emplace_back(0.1f * i, 0.1f * j, 0.0f);
+            mesh.normals.emplace_back(0.0f, 0.0f, 1.0f);
+            mesh.colors.emplace_back(i / 3.0f, j / 2.0f, 0.25f);
+        }
+    }
+    for (std::uint32_t j = 0; j < 2; ++j) {
+        for (std::uint32_t i = 0; i < 3; ++i) {
+            const std::uint32_t v = j * 4 + i;
+            mesh.triangles.push_back({v, v + 1, v + 5});
+            mesh.triangles.push_back({v, v + 5, v + 4});
+        }
+    }
+    return mesh;
+}
+
+Eigen::Vector3f displayColor(const Eigen::Vector3f& linear) {
+    return linear.array().pow(1.0f / 2.2f).matrix();
+}
+
+struct Imported {
+    unsigned vertices = 0;
+    unsigned faces = 0;
+    aiVector3D min{1e30f, 1e30f, 1e30f}, max{-1e30f, -1e30f, -1e30f};
+    // Colour of each imported vertex keyed by its rounded position.
+    std::map<std::pair<int, int>, aiColor4D> colors;
+};
+
+Imported importMesh(const fs::path& path) {
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path.string(), aiProcess_JoinIdenticalVertices);
+    Imported out;
+    if (!scene) {
+        ADD_FAILURE() << "assimp cannot read " << path << ": " << importer.GetErrorString();
+        return out;
+    }
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+        const aiMesh& mesh = *scene->mMeshes[m];
+        out.vertices += mesh.mNumVertices;
+        out.faces += mesh.mNumFaces;
+        for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+            const aiVector3D& p = mesh.mVertices[v];
+            out.min = aiVector3D(std::min(out.min.x, p.x), std::min(out.min.y, p.y),
+                                 std::min(out.min.z, p.z));
+            out.max = aiVector3D(std::max(out.max.x, p.x), std::max(out.max.y, p.y),
+                                 std::max(out.max.z, p.z));
+            if (mesh.mColors[0])
+                out.colors[{int(std::lround(p.x * 10)), int(std::lround(p.y * 10))}] =
+                    mesh.mColors[0][v];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST(MeshExport, ParsesFormatNames) {
+    EXPECT_EQ(rend::render::parseMeshFormat("ply"), MeshFormat::Ply);
+    EXPECT_EQ(rend::render::parseMeshFormat("OBJ"), MeshFormat::Obj);
+    EXPECT_EQ(rend::render::parseMeshFormat(".glb"), MeshFormat::Glb);
+    EXPECT_THROW(rend::render::parseMeshFormat("stl"), std::invalid_argument);
+    EXPECT_THROW(rend::render::parseMeshFormat(""), std::invalid_argument);
+}
+
+TEST(MeshExport, EveryFormatRoundTripsThroughAssimp) {
+    const Mesh mesh = colouredGrid();
+    for (const char* name : {"ply", "obj", "glb"}) {
+        SCOPED_TRACE(name);
+        const MeshFormat format = rend::render::parseMeshFormat(name);
+        const fs::path dir = scratchDir(std::string("export_") + name);
+        const fs::path path = dir / (std::string("frame_0001.") + name);
+        rend::render::exportMesh(mesh, path, format);
+        ASSERT_TRUE(fs::exists(path));
+        EXPECT_FALSE(anyTmpLeft(dir));
+        if (format == MeshFormat::Obj) {
+            EXPECT_TRUE(fs::exists(dir / "frame_0001.mtl"));
+        }
+        const Imported back = importMesh(path);
+        EXPECT_EQ(back.faces, mesh.triangles.size());
+        EXPECT_EQ(back.vertices, mesh.positions.size());
+        EXPECT_NEAR(back.min.x, 0.0f, 1e-6f);
+        EXPECT_NEAR(back.max.x, 0.3f, 1e-6f);
+        EXPECT_NEAR(back.max.y, 0.2f, 1e-6f);
+        if (format == MeshFormat::Obj) continue;  // OBJ has no standard vertex colours
+        ASSERT_EQ(back.colors.size(), mesh.positions.size());
+        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+            const auto& p = mesh.positions[v];
+            const aiColor4D c =
+                back.colors.at({int(std::lround(p.x() * 10)), int(std::lround(p.y() * 10))});
+            // PLY stores display (gamma 2.2) bytes, GLB linear floats.
+            const Eigen::Vector3f expected =
+                format == MeshFormat::Ply ? displayColor(mesh.colors[v]) : mesh.colors[v];
+            EXPECT_NEAR(c.r, expected.x(), 0.51 / 255);
+            EXPECT_NEAR(c.g, expected.y(), 0.51 / 255);
+            EXPECT_NEAR(c.b, expected.z(), 0.51 / 255);
+        }
+    }
+}
+
+TEST(MeshExport, PlyIsBinaryWithByteColours) {
+    const fs::path dir = scratchDir("export_ply_header");
+    rend::render::exportMesh(colouredGrid(), dir / "m.ply", MeshFormat::Ply);
+    std::ifstream in(dir / "m.ply", std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t end = text.find("end_header\n");
+    ASSERT_NE(end, std::string::npos);
+    EXPECT_NE(text.find("format binary_little_endian 1.0"), std::string::npos);
+    EXPECT_NE(text.find("property uchar red"), std::string::npos);
+    // 12 vertices of 3 + 3 floats and 3 bytes, 12 faces of a count byte and 3 uint32.
+    EXPECT_EQ(text.size() - (end + 11), 12u * 27u + 12u * 13u);
+}
+
+TEST(MeshExport, ObjReferencesItsMaterialLibraryByTheFinalName) {
+    const fs::path dir = scratchDir("export_mtl");
+    rend::render::exportMesh(colouredGrid(), dir / "sheet.obj", MeshFormat::Obj);
+    std::ifstream in(dir / "sheet.obj");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("mtllib sheet.mtl"), std::string::npos);
+}
+
+TEST(MeshExport, ExportedSurfacesKeepTheirTriangleCount) {
+    const Frame frame(0.2, 0.2);
+    const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), RenderSettings{});
+    const fs::path dir = scratchDir("export_lattice");
+    rend::render::exportMesh(mesh, dir / "lattice.glb", MeshFormat::Glb);
+    EXPECT_EQ(importMesh(dir / "lattice.glb").faces, mesh.triangles.size());
+}
+
+TEST(MeshExport, FailureThrowsAndLeavesNothingBehind) {
+    const fs::path dir = scratchDir("export_fail");
+    std::ofstream(dir / "not_a_folder") << "x";
+    EXPECT_THROW(
+        rend::render::exportMesh(colouredGrid(), dir / "not_a_folder" / "m.ply", MeshFormat::Ply),
+        std::runtime_error);
+    EXPECT_FALSE(anyTmpLeft(dir));
+}

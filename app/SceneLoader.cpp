@@ -685,6 +685,10 @@ void readPathTracing(const TableReader& t, render::PathTracing& p) {
     constexpr Param kTransmission{"transmission", "the fraction of light passing through", "0.3"};
     constexpr Param kSky{"sky", "a sky gradient instead of the constant background", "true"};
     constexpr Param kSunRadius{"sun_radius", "the sun's angular radius in degrees", "2.0"};
+    constexpr Param kZenith{"sky_zenith", "the sky colour overhead [r, g, b]",
+                            "[0.35, 0.50, 0.80]"};
+    constexpr Param kHorizon{"sky_horizon", "the sky colour at the horizon [r, g, b]",
+                             "[0.85, 0.88, 0.92]"};
     p.samplesPerPixel = int(t.integer(kSpp, Range::closed(1, 4096)).value_or(p.samplesPerPixel));
     p.maxDepth = int(t.integer(kDepth, Range::closed(1, 64)).value_or(p.maxDepth));
     p.material =
@@ -694,6 +698,8 @@ void readPathTracing(const TableReader& t, render::PathTracing& p) {
     p.sky = t.boolean(kSky).value_or(p.sky);
     p.sunAngularRadiusDegrees =
         t.number(kSunRadius, Range::closed(0.0, 30.0)).value_or(p.sunAngularRadiusDegrees);
+    p.skyZenith = t.vec3(kZenith, Range::closed(0.0, 10.0)).value_or(p.skyZenith);
+    p.skyHorizon = t.vec3(kHorizon, Range::closed(0.0, 10.0)).value_or(p.skyHorizon);
 }
 
 void readSurface(const TableReader& t, render::RenderSettings& r) {
@@ -717,30 +723,15 @@ void readSurface(const TableReader& t, render::RenderSettings& r) {
 
 void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& scene) {
     const TableReader t = root.section({"render", "image settings", ""}, "[render]",
-                                       {"renderer",
-                                        "width",
-                                        "height",
-                                        "supersample",
-                                        "color_by",
-                                        "color_range",
-                                        "albedo",
-                                        "background",
-                                        "ground_color",
-                                        "ground",
-                                        "ground_height",
-                                        "spp",
-                                        "max_depth",
-                                        "material",
-                                        "roughness",
-                                        "transmission",
-                                        "sky",
-                                        "sun_radius",
-                                        "surface",
-                                        "thickness",
-                                        "vdb_voxel_size",
-                                        "vdb_particle_radius",
-                                        "vdb_smoothing",
-                                        "vdb_adaptivity"},
+                                       {"renderer",      "width",          "height",
+                                        "supersample",   "color_by",       "color_range",
+                                        "albedo",        "background",     "ground_color",
+                                        "ground",        "ground_height",  "spp",
+                                        "max_depth",     "sky_zenith",     "sky_horizon",
+                                        "material",      "roughness",      "transmission",
+                                        "sky",           "sun_radius",     "surface",
+                                        "thickness",     "vdb_voxel_size", "vdb_particle_radius",
+                                        "vdb_smoothing", "vdb_adaptivity"},
                                        sectionFix("render"));
     constexpr Param kAlbedo{"albedo", "the surface colour [r, g, b]", "[0.78, 0.80, 0.85]"};
     constexpr Param kBackground{"background", "the sky colour [r, g, b]", "[0.80, 0.84, 0.90]"};

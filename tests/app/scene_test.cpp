@@ -294,6 +294,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"bad_too_many_particles.toml",
                  "4:6",
                  {"sheet.dx: expected a spacing of at least 0.0045 m", "at most 5e6 particles"}},
+        BadScene{"bad_export.toml",
+                 "11:10",
+                 {"output.export: expected format names among \"ply\", \"obj\", \"glb\", \"vdb\"",
+                  "found a string \"stl\""}},
+        BadScene{
+            "bad_surface.toml",
+            "11:11",
+            {"render.surface: expected one of \"lattice\", \"splat\", \"vdb\", found \"splats\"",
+             "Did you mean \"splat\"?"}},
         BadScene{"bad_law.toml",
                  "9:7",
                  {"material.law: expected one of \"linear\", \"power_law\", \"elastoplastic\", "
@@ -857,4 +866,51 @@ edge = "right"
                          0),
               0u)
         << edge;
+}
+
+TEST_F(SceneTest, RenderingKeysAndExportsAreRead) {
+    const fs::path file = writeScene("render_keys.toml", R"(
+[sheet]
+size = [1.0, 1.0]
+dx = 0.05
+[material]
+E = 2e4
+density = 5000
+[render]
+renderer = "embree"
+surface = "vdb"
+thickness = 0.002
+spp = 64
+max_depth = 6
+material = "conductor"
+roughness = 0.2
+transmission = 0.1
+sky = false
+sun_radius = 0.5
+sky_zenith = [0.1, 0.2, 0.3]
+vdb_voxel_size = 0.01
+vdb_particle_radius = 0.02
+vdb_smoothing = 3
+vdb_adaptivity = 0.5
+[output]
+export = ["glb", "vdb"]
+)");
+    const Scene s = loadScene(file);
+    EXPECT_EQ(s.renderer, RendererKind::Embree);
+    EXPECT_EQ(s.render.surface, render::SurfaceKind::Vdb);
+    EXPECT_DOUBLE_EQ(s.render.thickness, 0.002);
+    const render::PathTracing& p = s.render.pathTracing;
+    EXPECT_EQ(p.samplesPerPixel, 64);
+    EXPECT_EQ(p.maxDepth, 6);
+    EXPECT_EQ(p.material, render::MaterialKind::Conductor);
+    EXPECT_DOUBLE_EQ(p.roughness, 0.2);
+    EXPECT_DOUBLE_EQ(p.transmission, 0.1);
+    EXPECT_FALSE(p.sky);
+    EXPECT_DOUBLE_EQ(p.sunAngularRadiusDegrees, 0.5);
+    EXPECT_DOUBLE_EQ(p.skyZenith.z(), 0.3);
+    EXPECT_DOUBLE_EQ(s.render.vdb.voxelSize, 0.01);
+    EXPECT_DOUBLE_EQ(s.render.vdb.particleRadius, 0.02);
+    EXPECT_EQ(s.render.vdb.smoothingIterations, 3);
+    EXPECT_DOUBLE_EQ(s.render.vdb.adaptivity, 0.5);
+    EXPECT_EQ(s.exports, (std::vector<ExportFormat>{ExportFormat::Glb, ExportFormat::Vdb}));
 }

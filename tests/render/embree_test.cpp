@@ -7,16 +7,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "TestSupport.h"
 #include "render/EmbreeRenderer.h"
 #include "render/Image.h"
 
-namespace fs = std::filesystem;
 using rend::render::EmbreeRenderer;
 using rend::render::Geometry;
 using rend::render::Image;
@@ -24,6 +23,10 @@ using rend::render::MaterialKind;
 using rend::render::Mesh;
 using rend::render::RenderSettings;
 using rend::render::Splats;
+using rend::test::expectMatchesReference;
+using rend::test::pixel;
+using rend::test::pixelDistance;
+using rend::test::pixelsUnlike;
 
 namespace {
 
@@ -54,22 +57,10 @@ Eigen::Vector3f normal(const Eigen::Vector3f& p, double phase) {
 }
 
 Mesh wavyMesh(double phase = 0.0, Eigen::Vector3f color = Eigen::Vector3f(0.8f, 0.8f, 0.8f)) {
-    Mesh mesh;
-    for (int j = 0; j < kNy; ++j) {
-        for (int i = 0; i < kNx; ++i) {
-            mesh.positions.push_back(point(i, j, phase));
-            mesh.normals.push_back(normal(mesh.positions.back(), phase));
-            mesh.colors.push_back(color);
-        }
-    }
-    auto id = [](int i, int j) { return std::uint32_t(j * kNx + i); };
-    for (int j = 0; j + 1 < kNy; ++j) {
-        for (int i = 0; i + 1 < kNx; ++i) {
-            mesh.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-            mesh.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-        }
-    }
-    return mesh;
+    return rend::test::gridMesh(kNx, kNy, [&](int i, int j) {
+        const Eigen::Vector3f p = point(i, j, phase);
+        return rend::test::GridVertex{p, normal(p, phase), color};
+    });
 }
 
 // One disc per grid point. A radius of 0.8 dx exceeds half the cell diagonal (0.71 dx), so
@@ -102,16 +93,6 @@ RenderSettings smallSettings(MaterialKind material = MaterialKind::Diffuse) {
     return settings;
 }
 
-const std::uint8_t* pixel(const Image& image, int x, int y) {
-    return &image.rgb[(std::size_t(y) * image.width + x) * 3];
-}
-
-int pixelDistance(const std::uint8_t* a, const std::uint8_t* b) {
-    int d = 0;
-    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[c]) - int(b[c])));
-    return d;
-}
-
 double meanAbsDifference(const Image& a, const Image& b) {
     double sum = 0.0;
     for (std::size_t k = 0; k < a.rgb.size(); ++k) sum += std::abs(int(a.rgb[k]) - int(b.rgb[k]));
@@ -127,12 +108,6 @@ double maxLuma(const Image& image) {
     return best;
 }
 
-fs::path scratchDir() {
-    const fs::path dir = fs::path(::testing::TempDir()) / "rend_render_tests";
-    fs::create_directories(dir);
-    return dir;
-}
-
 Image renderOnce(const Geometry& geometry, const RenderSettings& settings) {
     EmbreeRenderer renderer;
     return renderer.render(geometry, settings);
@@ -146,29 +121,6 @@ Image withThreads(int threads, F body) {
     Image image = body();
     omp_set_num_threads(previous);
     return image;
-}
-
-void expectMatchesReference(const Image& actual, const std::string& name) {
-    const fs::path reference = fs::path(REND_SOURCE_DIR) / "tests/data" / (name + ".png");
-    const char* regenerate = std::getenv("REND_REGENERATE_REFERENCES");
-    if (regenerate && std::string(regenerate) == "1") {
-        rend::render::writePngAtomic(actual, reference);
-        std::cout << "[ regenerated ] " << reference << "\n";
-        return;
-    }
-    ASSERT_TRUE(fs::exists(reference))
-        << reference << " is missing; run with REND_REGENERATE_REFERENCES=1 to create it";
-    const auto diff = rend::render::compareImages(rend::render::readPng(reference), actual, 8);
-    if (diff.failingFraction > 0.01) {
-        const fs::path actualPath = scratchDir() / (name + "_actual.png");
-        const fs::path diffPath = scratchDir() / (name + "_diff.png");
-        rend::render::writePngAtomic(actual, actualPath);
-        rend::render::writePngAtomic(diff.diff, diffPath);
-        ADD_FAILURE() << "rendered image differs from " << reference << ": "
-                      << diff.failingFraction * 100 << "% of pixels off by more than 8 (max "
-                      << diff.maxDifference << ")\n  actual: " << actualPath
-                      << "\n  diff:   " << diffPath;
-    }
 }
 
 }  // namespace
@@ -195,11 +147,7 @@ TEST(EmbreeRenderer, SheetIsVisibleAsMeshAndAsSplats) {
         EXPECT_GT(renderer.raysTraced(), 160LL * 90 * 4);
         const std::uint8_t* corner = pixel(image, 0, 0);
         EXPECT_GT(pixelDistance(pixel(image, 80, 45), corner), 30);
-        int covered = 0;
-        for (int y = 0; y < image.height; ++y)
-            for (int x = 0; x < image.width; ++x)
-                covered += pixelDistance(pixel(image, x, y), corner) > 8;
-        EXPECT_GT(covered, image.width * image.height / 10);
+        EXPECT_GT(pixelsUnlike(image, corner, 8), image.width * image.height / 10);
     }
 }
 

@@ -6,7 +6,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -16,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "TestSupport.h"
 #include "render/ColorMap.h"
 #include "render/Image.h"
 #include "render/LatticeSurface.h"
@@ -29,92 +29,14 @@ using rend::render::Image;
 using rend::render::LatticeSurface;
 using rend::render::RenderSettings;
 using rend::sim::FrameView;
+using rend::test::expectMatchesReference;
+using rend::test::GridSheet;
+using rend::test::pixel;
+using rend::test::pixelDistance;
+using rend::test::pixelsUnlike;
+using rend::test::scratchDir;
 
 namespace {
-
-// A square particle grid in the z = 0 plane, centred on the origin, with every cell split
-// into two counter-clockwise triangles and bonds to all 8 neighbours (so every triangle edge,
-// diagonals included, is a bond). Built here rather than by the simulator's lattice
-// generator so these tests pin down render/ alone.
-struct Sheet {
-    int nx;
-    int ny;
-    double dx;
-    std::vector<Eigen::Vector3d> positions, velocities, rest;
-    std::vector<std::array<int, 3>> triangles;
-    std::vector<int> offsets, partners;
-    std::vector<double> restLength;
-    std::vector<std::uint8_t> alive;
-
-    Sheet(int nx_, int ny_, double dx_) : nx(nx_), ny(ny_), dx(dx_) {
-        makeParticles();
-        makeTriangles();
-        makeBonds();
-    }
-
-    int id(int i, int j) const { return j * nx + i; }
-
-    FrameView view() const {
-        FrameView v;
-        v.frame = 1;
-        v.positions = positions;
-        v.velocities = velocities;
-        v.restPositions = rest;
-        v.restTriangles = triangles;
-        v.bondOffsets = offsets;
-        v.bondPartners = partners;
-        v.bondRestLength = restLength;
-        v.bondAlive = alive;
-        return v;
-    }
-
-    void breakBond(int a, int b) {
-        const FrameView v = view();
-        alive.at(v.findBond(a, b)) = 0;
-        alive.at(v.findBond(b, a)) = 0;
-    }
-
-private:
-    void makeParticles() {
-        for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i)
-                rest.emplace_back((i - 0.5 * (nx - 1)) * dx, (j - 0.5 * (ny - 1)) * dx, 0.0);
-        positions = rest;
-        velocities.assign(rest.size(), Eigen::Vector3d::Zero());
-    }
-
-    void makeTriangles() {
-        for (int j = 0; j + 1 < ny; ++j) {
-            for (int i = 0; i + 1 < nx; ++i) {
-                triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-                triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-            }
-        }
-    }
-
-    void makeBonds() {
-        offsets.push_back(0);
-        for (int j = 0; j < ny; ++j) {
-            for (int i = 0; i < nx; ++i) {
-                addNeighbours(i, j);
-                offsets.push_back(static_cast<int>(partners.size()));
-            }
-        }
-        alive.assign(partners.size(), 1);
-    }
-
-    void addNeighbours(int i, int j) {
-        for (int dj = -1; dj <= 1; ++dj) {
-            for (int di = -1; di <= 1; ++di) {
-                const int ni = i + di;
-                const int nj = j + dj;
-                if ((di == 0 && dj == 0) || ni < 0 || nj < 0 || ni >= nx || nj >= ny) continue;
-                partners.push_back(id(ni, nj));
-                restLength.push_back((rest[id(ni, nj)] - rest[id(i, j)]).norm());
-            }
-        }
-    }
-};
 
 Image solidImage(int w, int h, std::uint8_t value) {
     return Image{w, h, std::vector<std::uint8_t>(std::size_t(w) * h * 3, value)};
@@ -124,24 +46,18 @@ double luminance(const Eigen::Vector3f& c) {
     return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
 }
 
-fs::path scratchDir() {
-    const fs::path dir = fs::path(::testing::TempDir()) / "rend_render_tests";
-    fs::create_directories(dir);
-    return dir;
-}
-
 }  // namespace
 
 // ---- LatticeSurface ------------------------------------------------------------------------
 
 TEST(LatticeSurface, KeepsEveryTriangleWhenAllBondsAreIntact) {
-    const Sheet sheet(6, 5, 1.0);
+    const GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     EXPECT_EQ(surface.keptTriangles(sheet.view()).size(), sheet.triangles.size());
 }
 
 TEST(LatticeSurface, BrokenInteriorBondDropsBothAdjacentTriangles) {
-    Sheet sheet(6, 5, 1.0);
+    GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     // The horizontal edge (2,2)-(3,2) has one triangle of cell (2,1) below it and one of
     // cell (2,2) above it.
@@ -155,14 +71,14 @@ TEST(LatticeSurface, BrokenInteriorBondDropsBothAdjacentTriangles) {
 }
 
 TEST(LatticeSurface, BrokenBoundaryBondDropsItsSingleTriangle) {
-    Sheet sheet(6, 5, 1.0);
+    GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     sheet.breakBond(sheet.id(0, 0), sheet.id(1, 0));
     EXPECT_EQ(surface.keptTriangles(sheet.view()).size(), sheet.triangles.size() - 1);
 }
 
 TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {
-    Sheet sheet(6, 5, 1.0);
+    GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
     const auto mesh = surface.build(sheet.view(), RenderSettings{});
@@ -174,7 +90,7 @@ TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {
 }
 
 TEST(LatticeSurface, NormalsOfAFlatSheetAtRestAreUnitAndPointUp) {
-    const Sheet sheet(6, 5, 0.5);
+    const GridSheet sheet(6, 5, 0.5);
     const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), RenderSettings{});
     for (const auto& n : mesh.normals) {
         EXPECT_NEAR(n.norm(), 1.0f, 1e-6f);
@@ -183,7 +99,7 @@ TEST(LatticeSurface, NormalsOfAFlatSheetAtRestAreUnitAndPointUp) {
 }
 
 TEST(LatticeSurface, IsolatedVertexGetsTheUpNormal) {
-    Sheet sheet(3, 3, 1.0);
+    GridSheet sheet(3, 3, 1.0);
     const LatticeSurface surface(sheet.view());
     // Cutting every bond of the corner particle leaves it referenced by no triangle.
     for (int b = sheet.offsets[0]; b < sheet.offsets[1]; ++b) sheet.breakBond(0, sheet.partners[b]);
@@ -197,7 +113,7 @@ namespace {
 // Breaks every bond that is not an edge of a triangle of a kept cell, so exactly those cells'
 // triangles survive.
 template <typename KeepCell>
-void keepOnlyCells(Sheet& sheet, KeepCell keep) {
+void keepOnlyCells(GridSheet& sheet, KeepCell keep) {
     std::set<std::pair<int, int>> edges;
     for (int j = 0; j + 1 < sheet.ny; ++j) {
         for (int i = 0; i + 1 < sheet.nx; ++i) {
@@ -241,7 +157,7 @@ void expectIndicesInRange(const rend::render::Mesh& mesh) {
 }  // namespace
 
 TEST(LatticeSurfaceCracks, IntactSheetHasNoExtraVertices) {
-    const Sheet sheet(6, 5, 1.0);
+    const GridSheet sheet(6, 5, 1.0);
     const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), RenderSettings{});
     EXPECT_EQ(mesh.positions.size(), sheet.positions.size());
     EXPECT_EQ(triangleComponents(mesh).size(), sheet.triangles.size());
@@ -249,7 +165,7 @@ TEST(LatticeSurfaceCracks, IntactSheetHasNoExtraVertices) {
 
 TEST(LatticeSurfaceCracks, SlitEndingInsideTheSheetAddsNoVertex) {
     // One broken bond opens a slit, but every particle's kept triangles still form one fan.
-    Sheet sheet(6, 5, 1.0);
+    GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
     EXPECT_EQ(surface.build(sheet.view(), RenderSettings{}).positions.size(),
@@ -258,7 +174,7 @@ TEST(LatticeSurfaceCracks, SlitEndingInsideTheSheetAddsNoVertex) {
 
 TEST(LatticeSurfaceCracks, BowtieParticleGetsExactlyOneCopy) {
     // Keep the lower-left and upper-right quadrants of a 5 x 5 sheet: they touch only at (2,2).
-    Sheet sheet(5, 5, 1.0);
+    GridSheet sheet(5, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     keepOnlyCells(sheet, [](int i, int j) { return (i < 2) == (j < 2); });
     sheet.positions[sheet.id(2, 2)] = Eigen::Vector3d(0.25, -0.5, 0.75);
@@ -291,7 +207,7 @@ TEST(LatticeSurfaceCracks, SheetCutFullyAcrossFallsIntoTwoPiecesSharingNoVertex)
     // Break every bond crossing the anti-diagonal line i + j = n - 1, which runs through
     // particles: the two halves touch at each of the n - 2 interior particles on the line.
     constexpr int n = 7;
-    Sheet sheet(n, n, 1.0);
+    GridSheet sheet(n, n, 1.0);
     const LatticeSurface surface(sheet.view());
     auto side = [&](int p) { return (p % n + p / n > n - 1) - (p % n + p / n < n - 1); };
     for (int a = 0; a < n * n; ++a)
@@ -354,7 +270,7 @@ TEST(ColorMap, ClampsOutOfRangeInputsToTheEndpoints) {
 }
 
 TEST(ColorMap, StrainOfAUniformlyStretchedSheetIsTheStretch) {
-    Sheet sheet(6, 5, 1.0);
+    GridSheet sheet(6, 5, 1.0);
     for (std::size_t i = 0; i < sheet.positions.size(); ++i)
         sheet.positions[i] = 1.1 * sheet.rest[i];
     const auto strain = rend::render::particleField(sheet.view(), ColorBy::Strain);
@@ -363,7 +279,7 @@ TEST(ColorMap, StrainOfAUniformlyStretchedSheetIsTheStretch) {
 }
 
 TEST(ColorMap, StrainIgnoresBrokenBonds) {
-    Sheet sheet(3, 1, 1.0);
+    GridSheet sheet(3, 1, 1.0);
     sheet.positions[2].x() += 1.0;  // stretch only the (1,2) bond, then break it
     sheet.breakBond(1, 2);
     const auto strain = rend::render::particleField(sheet.view(), ColorBy::Strain);
@@ -373,7 +289,7 @@ TEST(ColorMap, StrainIgnoresBrokenBonds) {
 }
 
 TEST(ColorMap, SpeedIsTheVelocityMagnitude) {
-    Sheet sheet(2, 2, 1.0);
+    GridSheet sheet(2, 2, 1.0);
     sheet.velocities[3] = Eigen::Vector3d(3.0, 0.0, 4.0);
     const auto speed = rend::render::particleField(sheet.view(), ColorBy::Speed);
     EXPECT_DOUBLE_EQ(speed[0], 0.0);
@@ -382,7 +298,7 @@ TEST(ColorMap, SpeedIsTheVelocityMagnitude) {
 }
 
 TEST(ColorMap, ColoursUseAlbedoWithoutAFieldAndTheFieldMaximumOtherwise) {
-    Sheet sheet(2, 2, 1.0);
+    GridSheet sheet(2, 2, 1.0);
     sheet.velocities[3] = Eigen::Vector3d(0.0, 0.0, 2.0);
     RenderSettings settings;
     auto colors = rend::render::particleColors(sheet.view(), settings);
@@ -397,7 +313,7 @@ TEST(ColorMap, ColoursUseAlbedoWithoutAFieldAndTheFieldMaximumOtherwise) {
 }
 
 TEST(ColorMap, AllZeroFieldMapsToTheLowEnd) {
-    const Sheet sheet(2, 2, 1.0);
+    const GridSheet sheet(2, 2, 1.0);
     RenderSettings settings;
     settings.colorBy = ColorBy::Speed;
     for (const auto& c : rend::render::particleColors(sheet.view(), settings))
@@ -432,7 +348,7 @@ TEST(ColorMap, ThetaBrightnessFallsMonotonically) {
 }
 
 TEST(ColorMap, ThetaAndDamageFieldsAreTheFrameValuesOrZeros) {
-    Sheet sheet(2, 2, 1.0);
+    GridSheet sheet(2, 2, 1.0);
     const std::vector<double> theta{0.0, 0.5, 1.5, 3.0};
     const std::vector<double> damage{0.25, 0.0, 1.0, 0.5};
     EXPECT_EQ(rend::render::particleField(sheet.view(), ColorBy::Theta),
@@ -447,7 +363,7 @@ TEST(ColorMap, ThetaAndDamageFieldsAreTheFrameValuesOrZeros) {
 }
 
 TEST(ColorMap, ThetaUsesTheRedMapAndDamageViridis) {
-    Sheet sheet(2, 2, 1.0);
+    GridSheet sheet(2, 2, 1.0);
     const std::vector<double> values{0.0, 1.0, 2.0, 4.0};
     FrameView view = sheet.view();
     view.theta = values;
@@ -537,10 +453,10 @@ namespace {
 
 // A 2.3 x 1.5 sheet with a gentle standing wave along x; the stretched flanks of the wave
 // light up in the strain colouring.
-Sheet wavySheet() {
-    Sheet sheet(24, 16, 0.1);
-    for (auto& p : sheet.positions) p.z() = 0.15 * std::sin(2.0 * std::numbers::pi * p.x() / 1.2);
-    return sheet;
+GridSheet wavySheet() {
+    return GridSheet(24, 16, 0.1, [](double x, double) {
+        return 0.15 * std::sin(2.0 * std::numbers::pi * x / 1.2);
+    });
 }
 
 RenderSettings smallSettings() {
@@ -557,20 +473,10 @@ RenderSettings smallSettings() {
 }
 
 Image renderWavySheet(const RenderSettings& settings) {
-    const Sheet sheet = wavySheet();
+    const GridSheet sheet = wavySheet();
     const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), settings);
     rend::render::OsmesaRenderer renderer;
     return renderer.render(mesh, settings);
-}
-
-const std::uint8_t* pixel(const Image& image, int x, int y) {
-    return &image.rgb[(std::size_t(y) * image.width + x) * 3];
-}
-
-int pixelDistance(const std::uint8_t* a, const std::uint8_t* b) {
-    int d = 0;
-    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[c]) - int(b[c])));
-    return d;
 }
 
 }  // namespace
@@ -589,11 +495,7 @@ TEST(OsmesaRenderer, DrawsTheSheetOverTheBackground) {
     const std::uint8_t* corner = pixel(image, 0, 0);
     // The camera looks at the sheet's centre, so the centre pixel must be sheet, not sky.
     EXPECT_GT(pixelDistance(pixel(image, 80, 45), corner), 30);
-    int covered = 0;
-    for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x)
-            covered += pixelDistance(pixel(image, x, y), corner) > 8;
-    EXPECT_GT(covered, image.width * image.height / 10);
+    EXPECT_GT(pixelsUnlike(image, corner, 8), image.width * image.height / 10);
 }
 
 TEST(OsmesaRenderer, EmptyMeshWithoutGroundIsPureBackground) {
@@ -607,7 +509,7 @@ TEST(OsmesaRenderer, EmptyMeshWithoutGroundIsPureBackground) {
 }
 
 TEST(OsmesaRenderer, SameInputGivesIdenticalPixelsAndResizesBetweenCalls) {
-    const Sheet sheet = wavySheet();
+    const GridSheet sheet = wavySheet();
     RenderSettings settings = smallSettings();
     const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), settings);
     rend::render::OsmesaRenderer renderer;
@@ -620,27 +522,7 @@ TEST(OsmesaRenderer, SameInputGivesIdenticalPixelsAndResizesBetweenCalls) {
 }
 
 TEST(OsmesaRenderer, MatchesTheReferenceImage) {
-    const fs::path reference = fs::path(REND_SOURCE_DIR) / "tests/data/osmesa_sheet.png";
-    const Image actual = renderWavySheet(smallSettings());
-    const char* regenerate = std::getenv("REND_REGENERATE_REFERENCES");
-    if (regenerate && std::string(regenerate) == "1") {
-        rend::render::writePngAtomic(actual, reference);
-        std::cout << "[ regenerated ] " << reference << "\n";
-        return;
-    }
-    ASSERT_TRUE(fs::exists(reference))
-        << reference << " is missing; run with REND_REGENERATE_REFERENCES=1 to create it";
-    const auto diff = rend::render::compareImages(rend::render::readPng(reference), actual, 8);
-    if (diff.failingFraction > 0.01) {
-        const fs::path actualPath = scratchDir() / "osmesa_sheet_actual.png";
-        const fs::path diffPath = scratchDir() / "osmesa_sheet_diff.png";
-        rend::render::writePngAtomic(actual, actualPath);
-        rend::render::writePngAtomic(diff.diff, diffPath);
-        ADD_FAILURE() << "rendered image differs from " << reference << ": "
-                      << diff.failingFraction * 100 << "% of pixels off by more than 8 (max "
-                      << diff.maxDifference << ")\n  actual: " << actualPath
-                      << "\n  diff:   " << diffPath;
-    }
+    expectMatchesReference(renderWavySheet(smallSettings()), "osmesa_sheet");
 }
 
 // ---- Versions ------------------------------------------------------------------------------

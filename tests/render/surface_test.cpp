@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "TestSupport.h"
 #include "render/ColorMap.h"
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
@@ -38,76 +39,18 @@ using rend::render::SplatSurface;
 using rend::render::VdbSettings;
 using rend::render::VdbSurface;
 using rend::sim::FrameView;
+using rend::test::membraneSheet;
+using rend::test::Sheet;
 
 namespace {
 
 constexpr double kDx = 0.02;
 
-// A hexagonal sheet from the simulator's public API, copied into arrays the tests own so they
-// can move particles and break bonds freely without touching the solver.
-struct Frame {
-    std::vector<Eigen::Vector3d> positions, velocities, rest;
-    std::vector<std::array<int, 3>> triangles;
-    std::vector<int> offsets, partners;
-    std::vector<double> restLength;
-    std::vector<std::uint8_t> alive;
-
-    explicit Frame(double sizeX, double sizeY) {
-        rend::sim::MembraneParams params;
-        params.sheet.size = {sizeX, sizeY};
-        params.sheet.dx = kDx;
-        const rend::sim::Membrane membrane(params);
-        const FrameView v = membrane.view(1);
-        positions.assign(v.positions.begin(), v.positions.end());
-        velocities.assign(v.velocities.begin(), v.velocities.end());
-        rest.assign(v.restPositions.begin(), v.restPositions.end());
-        triangles.assign(v.restTriangles.begin(), v.restTriangles.end());
-        offsets.assign(v.bondOffsets.begin(), v.bondOffsets.end());
-        partners.assign(v.bondPartners.begin(), v.bondPartners.end());
-        restLength.assign(v.bondRestLength.begin(), v.bondRestLength.end());
-        alive.assign(v.bondAlive.begin(), v.bondAlive.end());
-    }
-
-    int size() const { return int(positions.size()); }
-
-    FrameView view() const {
-        FrameView v;
-        v.frame = 1;
-        v.positions = positions;
-        v.velocities = velocities;
-        v.restPositions = rest;
-        v.restTriangles = triangles;
-        v.bondOffsets = offsets;
-        v.bondPartners = partners;
-        v.bondRestLength = restLength;
-        v.bondAlive = alive;
-        return v;
-    }
-
-    void breakBond(int a, int b) {
-        const FrameView v = view();
-        const int ab = v.findBond(a, b);
-        const int ba = v.findBond(b, a);
-        if (ab >= 0) alive[ab] = 0;
-        if (ba >= 0) alive[ba] = 0;
-    }
-
-    // The interior particle nearest the rest point (x, y).
-    int nearest(double x, double y) const {
-        int best = 0;
-        for (int i = 1; i < size(); ++i)
-            if ((rest[i].head<2>() - Eigen::Vector2d(x, y)).norm() <
-                (rest[best].head<2>() - Eigen::Vector2d(x, y)).norm())
-                best = i;
-        return best;
-    }
-};
-
 // z = A sin(k x): a wavy sheet with a known normal everywhere.
 constexpr double kWaveAmplitude = 0.02;
 constexpr double kWaveNumber = 2.0 * std::numbers::pi / 0.3;
 
-void makeWavy(Frame& frame) {
+void makeWavy(Sheet& frame) {
     for (int i = 0; i < frame.size(); ++i)
         frame.positions[i].z() = kWaveAmplitude * std::sin(kWaveNumber * frame.rest[i].x());
 }
@@ -217,7 +160,7 @@ void expectWellFormed(const Mesh& mesh) {
 // ---- SplatSurface ----------------------------------------------------------------------------
 
 TEST(SplatSurface, FlatSheetGetsOneOverlappingUpwardDiscPerParticle) {
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
     ASSERT_EQ(int(splats.centers.size()), frame.size());
     ASSERT_EQ(splats.normals.size(), splats.centers.size());
@@ -234,13 +177,13 @@ TEST(SplatSurface, FlatSheetGetsOneOverlappingUpwardDiscPerParticle) {
 
 TEST(SplatSurface, RadiusCoversTheHexagonalLattice) {
     // The plane is covered when the radius reaches the triangles' circumradius dx / sqrt(3).
-    const Frame frame(0.2, 0.2);
+    const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     EXPECT_GT(SplatSurface(frame.view()).radius(), kDx / std::sqrt(3.0));
     EXPECT_NEAR(rend::render::restSpacing(frame.view()), kDx, 1e-9);
 }
 
 TEST(SplatSurface, NormalsFollowAWavySheet) {
-    Frame frame(0.6, 0.3);
+    Sheet frame = membraneSheet(0.6, 0.3, kDx);
     makeWavy(frame);
     const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
     double worst = 0.0;
@@ -253,14 +196,14 @@ TEST(SplatSurface, NormalsFollowAWavySheet) {
 TEST(SplatSurface, NormalsStayOnTheRestUpperSideWhenTheSheetIsTurnedOver) {
     // Rotated by pi about x: the side that faced +z at rest now faces -z, and every normal
     // must say so (no per-particle flip towards +z).
-    Frame frame(0.3, 0.2);
+    Sheet frame = membraneSheet(0.3, 0.2, kDx);
     for (auto& p : frame.positions) p = Eigen::Vector3d(p.x(), -p.y(), -p.z() + 0.1);
     const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
     for (const auto& n : splats.normals) EXPECT_LT(n.z(), -0.9999f);
 }
 
 TEST(SplatSurface, ParticleWithoutTrianglesFallsBackToItsNeighbourPlane) {
-    Frame frame(0.6, 0.3);
+    Sheet frame = membraneSheet(0.6, 0.3, kDx);
     makeWavy(frame);
     const SplatSurface surface(frame.view());
     // Break the outer ring of the particle's star: its triangles all go, its bonds stay.
@@ -281,7 +224,7 @@ TEST(SplatSurface, ParticleWithoutTrianglesFallsBackToItsNeighbourPlane) {
 }
 
 TEST(SplatSurface, IsolatedParticlePointsUp) {
-    Frame frame(0.2, 0.2);
+    Sheet frame = membraneSheet(0.2, 0.2, kDx);
     const SplatSurface surface(frame.view());
     const int p = frame.nearest(0.0, 0.0);
     for (int b = frame.offsets[p]; b < frame.offsets[p + 1]; ++b)
@@ -292,7 +235,7 @@ TEST(SplatSurface, IsolatedParticlePointsUp) {
 }
 
 TEST(SplatSurface, ColoursComeFromTheColourMap) {
-    Frame frame(0.2, 0.2);
+    Sheet frame = membraneSheet(0.2, 0.2, kDx);
     for (int i = 0; i < frame.size(); ++i) frame.velocities[i] = Eigen::Vector3d(i, 0.0, 0.0);
     RenderSettings settings;
     settings.colorBy = ColorBy::Speed;
@@ -309,7 +252,7 @@ TEST(SplatSurface, RestWithoutBondsOrTrianglesIsRefused) {
 }
 
 TEST(SplatSurface, MeshHasAFanPerDiscFacingItsNormal) {
-    Frame frame(0.2, 0.2);
+    Sheet frame = membraneSheet(0.2, 0.2, kDx);
     makeWavy(frame);
     const auto splats = SplatSurface(frame.view()).build(frame.view(), RenderSettings{});
     constexpr int kSegments = 6;
@@ -346,7 +289,7 @@ void expectOneClosedPillow(const Mesh& mesh) {
 }  // namespace
 
 TEST(VdbSurface, FlatSheetIsOneClosedPillowWithoutHoles) {
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     VdbSurface surface(frame.view(), VdbSettings{});
     EXPECT_NEAR(surface.voxelSize(), 0.5 * kDx, 1e-12);
     EXPECT_NEAR(surface.particleRadius(), 0.75 * kDx, 1e-12);
@@ -366,7 +309,7 @@ TEST(VdbSurface, FlatSheetIsOneClosedPillowWithoutHoles) {
 }
 
 TEST(VdbSurface, SmoothingKeepsAThinSheetIntact) {
-    Frame frame(0.6, 0.3);
+    Sheet frame = membraneSheet(0.6, 0.3, kDx);
     makeWavy(frame);
     for (int iterations : {0, 2, 4}) {
         SCOPED_TRACE(iterations);
@@ -379,7 +322,7 @@ TEST(VdbSurface, SmoothingKeepsAThinSheetIntact) {
 }
 
 TEST(VdbSurface, SmoothingKeepsTheFlatPillowAboutOneAndAHalfDxThick) {
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     for (int iterations : {0, 1, 2, 4}) {
         SCOPED_TRACE(iterations);
         VdbSettings settings;
@@ -399,7 +342,7 @@ TEST(VdbSurface, SmoothingKeepsTheFlatPillowAboutOneAndAHalfDxThick) {
 TEST(VdbSurface, SheetWithAHoleHasEulerCharacteristicZero) {
     // Checks the hole detector above: without the particles near the centre the pillow is a
     // torus.
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     std::vector<Eigen::Vector3d> kept;
     for (const auto& p : frame.positions)
         if (p.head<2>().norm() > 2.5 * kDx) kept.push_back(p);
@@ -415,7 +358,7 @@ TEST(VdbSurface, SheetWithAHoleHasEulerCharacteristicZero) {
 }
 
 TEST(VdbSurface, SheetCutInTwoGivesTwoComponents) {
-    Frame frame(0.3, 0.2);
+    Sheet frame = membraneSheet(0.3, 0.2, kDx);
     VdbSurface surface(frame.view(), VdbSettings{});
     for (int i = 0; i < frame.size(); ++i)
         if (frame.rest[i].x() > 0.0) frame.positions[i].x() += 10.0 * kDx;
@@ -425,7 +368,7 @@ TEST(VdbSurface, SheetCutInTwoGivesTwoComponents) {
 }
 
 TEST(VdbSurface, VerticesTakeTheColourOfTheNearestParticle) {
-    Frame frame(0.3, 0.2);
+    Sheet frame = membraneSheet(0.3, 0.2, kDx);
     for (int i = 0; i < frame.size(); ++i)
         frame.velocities[i] = Eigen::Vector3d(frame.rest[i].x() > 0.0 ? 1.0 : 0.0, 0.0, 0.0);
     RenderSettings settings;
@@ -444,7 +387,7 @@ TEST(VdbSurface, VerticesTakeTheColourOfTheNearestParticle) {
 }
 
 TEST(VdbSurface, WrittenGridReadsBackWithTheSameActiveVoxels) {
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     VdbSurface surface(frame.view(), VdbSettings{});
     EXPECT_THROW(surface.writeVdb(scratchDir("early") / "x.vdb"), std::logic_error);
     surface.build(frame.view(), RenderSettings{});
@@ -460,7 +403,7 @@ TEST(VdbSurface, WrittenGridReadsBackWithTheSameActiveVoxels) {
 }
 
 TEST(VdbSurface, RadiusBelowOneAndAHalfVoxelsIsRefused) {
-    const Frame frame(0.2, 0.2);
+    const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     VdbSettings settings;
     settings.voxelSize = 0.01;
     settings.particleRadius = 0.0149;
@@ -477,14 +420,14 @@ TEST(VdbSurface, RadiusBelowOneAndAHalfVoxelsIsRefused) {
 // ---- LatticeSurface thickness ----------------------------------------------------------------
 
 TEST(LatticeThickness, ZeroThicknessIsTheSheet) {
-    const Frame frame(0.2, 0.2);
+    const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), RenderSettings{});
     EXPECT_EQ(int(mesh.positions.size()), frame.size());
     EXPECT_EQ(mesh.triangles.size(), frame.triangles.size());
 }
 
 TEST(LatticeThickness, ExtrudedIntactSheetIsAClosedSlab) {
-    const Frame frame(0.3, 0.2);
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
     RenderSettings settings;
     settings.thickness = 0.004;
     const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), settings);
@@ -498,7 +441,7 @@ TEST(LatticeThickness, ExtrudedIntactSheetIsAClosedSlab) {
 }
 
 TEST(LatticeThickness, CrackGetsWallsOnBothLips) {
-    Frame frame(0.3, 0.2);
+    Sheet frame = membraneSheet(0.3, 0.2, kDx);
     const LatticeSurface surface(frame.view());
     // Cut every bond crossing x = 0.005: two closed slabs.
     for (int i = 0; i < frame.size(); ++i)
@@ -518,22 +461,11 @@ namespace {
 
 // A 4 x 3 vertex grid in z = 0 with a different colour per vertex.
 Mesh colouredGrid() {
-    Mesh mesh;
-    for (int j = 0; j < 3; ++j) {
-        for (int i = 0; i < 4; ++i) {
-            mesh.positions.emplace_back(0.1f * i, 0.1f * j, 0.0f);
-            mesh.normals.emplace_back(0.0f, 0.0f, 1.0f);
-            mesh.colors.emplace_back(i / 3.0f, j / 2.0f, 0.25f);
-        }
-    }
-    for (std::uint32_t j = 0; j < 2; ++j) {
-        for (std::uint32_t i = 0; i < 3; ++i) {
-            const std::uint32_t v = j * 4 + i;
-            mesh.triangles.push_back({v, v + 1, v + 5});
-            mesh.triangles.push_back({v, v + 5, v + 4});
-        }
-    }
-    return mesh;
+    return rend::test::gridMesh(4, 3, [](int i, int j) {
+        return rend::test::GridVertex{Eigen::Vector3f(0.1f * i, 0.1f * j, 0.0f),
+                                      Eigen::Vector3f::UnitZ(),
+                                      Eigen::Vector3f(i / 3.0f, j / 2.0f, 0.25f)};
+    });
 }
 
 Eigen::Vector3f displayColor(const Eigen::Vector3f& linear) {
@@ -641,7 +573,7 @@ TEST(MeshExport, ObjReferencesItsMaterialLibraryByTheFinalName) {
 }
 
 TEST(MeshExport, ExportedSurfacesKeepTheirTriangleCount) {
-    const Frame frame(0.2, 0.2);
+    const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), RenderSettings{});
     const fs::path dir = scratchDir("export_lattice");
     rend::render::exportMesh(mesh, dir / "lattice.glb", MeshFormat::Glb);

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "render/ColorMap.h"
+#include "render/RestTopology.h"
 
 namespace rend::render {
 
@@ -18,12 +19,6 @@ bool bondIntact(const sim::FrameView& frame, int bond) {
     // Edges without a bond (e.g. square-lattice diagonals) carry no damage information, so
     // they never drop their triangle.
     return bond < 0 || frame.bondAlive[bond] != 0;
-}
-
-std::array<int, 3> edgeBonds(const sim::FrameView& rest, const std::array<int, 3>& t) {
-    std::array<int, 3> bonds{};
-    for (int e = 0; e < 3; ++e) bonds[e] = rest.findBond(t[e], t[(e + 1) % 3]);
-    return bonds;
 }
 
 std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& positions,
@@ -165,19 +160,9 @@ void extrude(Mesh& mesh, double thickness) {
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
       edgeNeighbours_(edgeNeighbours(triangles_)) {
-    edgeBonds_.reserve(triangles_.size());
-    for (const auto& t : triangles_) edgeBonds_.push_back(edgeBonds(rest, t));
-    // Counting sort by particle: the lists come out in ascending triangle order, which fixes
-    // which fan keeps the particle's own vertex.
-    incidentOffsets_.assign(vertexCount(rest, triangles_) + 1, 0);
-    for (const auto& t : triangles_)
-        for (int v : t) ++incidentOffsets_[v + 1];
-    for (std::size_t i = 1; i < incidentOffsets_.size(); ++i)
-        incidentOffsets_[i] += incidentOffsets_[i - 1];
-    incident_.resize(incidentOffsets_.back());
-    std::vector<int> fill(incidentOffsets_.begin(), incidentOffsets_.end() - 1);
-    for (int t = 0; t < static_cast<int>(triangles_.size()); ++t)
-        for (int v : triangles_[t]) incident_[fill[v]++] = t;
+    edgeBonds_ = triangleEdgeBonds(rest, triangles_);
+    // Ascending triangle order fixes which fan keeps the particle's own vertex.
+    incidentTriangles(triangles_, vertexCount(rest, triangles_), incidentOffsets_, incident_);
 }
 
 std::vector<std::uint8_t> LatticeSurface::keptFlags(const sim::FrameView& frame) const {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "render/ColorMap.h"
+#include "render/RestTopology.h"
 #include "sim/Parallel.h"
 
 namespace rend::render {
@@ -129,20 +130,8 @@ SplatSurface::SplatSurface(const sim::FrameView& rest)
         throw std::invalid_argument(
             "splat surface: the rest lattice has no bond and no triangle to size discs from");
     radius_ = std::max(kSpacingFactor * dx, kCircumradiusMargin * meanCircumradius(rest));
-    edgeBonds_.reserve(triangles_.size());
-    for (const auto& t : triangles_)
-        edgeBonds_.push_back(
-            {rest.findBond(t[0], t[1]), rest.findBond(t[1], t[2]), rest.findBond(t[2], t[0])});
-    // Counting sort by particle, as in LatticeSurface.
-    incidentOffsets_.assign(rest.particleCount() + 1, 0);
-    for (const auto& t : triangles_)
-        for (int v : t) ++incidentOffsets_[v + 1];
-    for (std::size_t i = 1; i < incidentOffsets_.size(); ++i)
-        incidentOffsets_[i] += incidentOffsets_[i - 1];
-    incident_.resize(incidentOffsets_.back());
-    std::vector<int> fill(incidentOffsets_.begin(), incidentOffsets_.end() - 1);
-    for (int t = 0; t < int(triangles_.size()); ++t)
-        for (int v : triangles_[t]) incident_[fill[v]++] = t;
+    edgeBonds_ = triangleEdgeBonds(rest, triangles_);
+    incidentTriangles(triangles_, rest.particleCount(), incidentOffsets_, incident_);
 }
 
 std::vector<std::uint8_t> SplatSurface::keptTriangles(const sim::FrameView& frame) const {

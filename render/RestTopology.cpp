@@ -1,0 +1,27 @@
+#include "render/RestTopology.h"
+
+namespace rend::render {
+
+std::vector<std::array<int, 3>> triangleEdgeBonds(
+    const sim::FrameView& rest, const std::vector<std::array<int, 3>>& triangles) {
+    std::vector<std::array<int, 3>> bonds;
+    bonds.reserve(triangles.size());
+    for (const auto& t : triangles)
+        bonds.push_back(
+            {rest.findBond(t[0], t[1]), rest.findBond(t[1], t[2]), rest.findBond(t[2], t[0])});
+    return bonds;
+}
+
+void incidentTriangles(const std::vector<std::array<int, 3>>& triangles, std::size_t vertexCount,
+                       std::vector<int>& offsets, std::vector<int>& incident) {
+    offsets.assign(vertexCount + 1, 0);
+    for (const auto& t : triangles)
+        for (int v : t) ++offsets[v + 1];
+    for (std::size_t i = 1; i < offsets.size(); ++i) offsets[i] += offsets[i - 1];
+    incident.resize(offsets.back());
+    std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+    for (int t = 0; t < int(triangles.size()); ++t)
+        for (int v : triangles[t]) incident[fill[v]++] = t;
+}
+
+}  // namespace rend::render

@@ -229,6 +229,9 @@ void readFracture(const TableReader& t, sim::MaterialParams& m) {
     m.criticalStretch = sim::CriticalStretchMode(
         t.choice(kCriticalStretch, kCriticalStretches).value_or(std::size_t(m.criticalStretch)));
     m.strengthLoss = t.number(kStrengthLoss, Range::nonNegative()).value_or(m.strengthLoss);
+    constexpr Param kSurfaceCorrection{
+        "surface_correction", "whether edge particles are stiffened to the interior's", "true"};
+    m.surfaceCorrection = t.boolean(kSurfaceCorrection).value_or(m.surfaceCorrection);
 }
 
 /// The diffusive quantity theta inside the material (eq. 25) and what it does to it.
@@ -246,12 +249,13 @@ void readDiffusivity(const TableReader& t, sim::MaterialParams& m) {
 
 sim::MaterialParams readMaterial(const TableReader& root) {
     constexpr Param kMaterial{"material", "the membrane's material", ""};
-    const TableReader t = root.section(
-        kMaterial, "[material]",
-        {"preset", "name", "E", "poisson", "density", "micromodulus", "law", "power_ratio",
-         "power_exponent", "yield_strain", "softening", "fracture_energy", "critical_stretch",
-         "capacity", "conductivity", "expansion", "stiffness_loss", "strength_loss"},
-        sectionFix("material"));
+    const TableReader t =
+        root.section(kMaterial, "[material]",
+                     {"preset", "name", "E", "poisson", "density", "micromodulus", "law",
+                      "power_ratio", "power_exponent", "yield_strain", "softening",
+                      "fracture_energy", "critical_stretch", "capacity", "conductivity",
+                      "expansion", "stiffness_loss", "strength_loss", "surface_correction"},
+                     sectionFix("material"));
     constexpr Param kPreset{"preset", "a file name under assets/materials without .toml",
                             "\"stretch_sheet\""};
     constexpr Param kName{"name", "the material's name", "\"rubber\""};
@@ -540,12 +544,14 @@ sim::DiffusionParams readDiffusion(const TableReader& root, const sim::SheetPara
 
 void readForces(const TableReader& root, sim::MembraneParams& p) {
     const TableReader t = root.section({"forces", "external forces", ""}, "[forces]",
-                                       {"gravity", "damping"}, sectionFix("forces"));
+                                       {"gravity", "damping", "pressure"}, sectionFix("forces"));
     constexpr Param kGravity{"gravity", "the gravitational acceleration [x, y, z] in m/s^2",
                              "[0.0, 0.0, -9.81]"};
     constexpr Param kDamping{"damping", "the velocity damping rate in 1/s", "0.1"};
     p.gravity = t.vec3(kGravity).value_or(p.gravity);
     p.damping = t.number(kDamping, Range::nonNegative()).value_or(p.damping);
+    constexpr Param kPressure{"pressure", "a uniform pressure on the +z side in Pa", "100.0"};
+    p.pressure = t.number(kPressure, Range::any()).value_or(p.pressure);
 }
 
 /// dt is a number or "auto"; returns where it was given, for the stability message.
@@ -565,9 +571,9 @@ std::string readTimeStep(const TableReader& t, sim::TimeParams& time) {
 }
 
 std::string readTime(const TableReader& root, sim::TimeParams& time) {
-    const TableReader t =
-        root.section({"time", "time stepping", ""}, "[time]",
-                     {"dt", "safety", "duration", "fps", "allow_unstable"}, sectionFix("time"));
+    const TableReader t = root.section(
+        {"time", "time stepping", ""}, "[time]",
+        {"dt", "safety", "duration", "fps", "allow_unstable", "integrator"}, sectionFix("time"));
     constexpr Param kSafety{"safety", "the fraction of the stable time step used by dt = \"auto\"",
                             "0.8"};
     constexpr Param kDuration{"duration", "the simulated time in seconds", "5.0"};
@@ -580,6 +586,10 @@ std::string readTime(const TableReader& root, sim::TimeParams& time) {
     time.duration = t.number(kDuration, Range::positive()).value_or(time.duration);
     time.fps = t.number(kFps, Range::positive()).value_or(time.fps);
     time.allowUnstable = t.boolean(kAllowUnstable).value_or(time.allowUnstable);
+    constexpr Param kIntegrator{"integrator", "the explicit scheme", "\"velocity_verlet\""};
+    static constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};
+    time.integrator =
+        sim::Integrator(t.choice(kIntegrator, kIntegrators).value_or(std::size_t(time.integrator)));
     if (time.duration * time.fps > kMaxFrames) {
         t.fail(t.has(kDuration.key) ? kDuration.key : kFps.key,
                "at most 1e6 frames (duration * fps)",

@@ -36,6 +36,13 @@ double interiorFamilySum(const BondFamilies& bonds, Term term) {
     return best;
 }
 
+/// Index of the bond i -> j in the CSR arrays, or -1 when i and j are not bonded.
+inline int findBond(const BondFamilies& bonds, int i, int j) {
+    for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+        if (bonds.partners[b] == j) return b;
+    return -1;
+}
+
 /// Every pair closer than `horizon` in the rest configuration, partners sorted by index.
 BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double horizon);
 

@@ -1,5 +1,6 @@
 #include "sim/Membrane.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -21,6 +22,13 @@ Membrane::Membrane(const MembraneParams& params)
     bonds_ = buildBondFamilies(x0_, horizon_);
     computeBondScales(params);
     setUpFracture(params);
+    if (params.pressure != 0.0) {
+        pressureEdgeBonds_.reserve(lattice_.triangles.size());
+        for (const auto& t : lattice_.triangles)
+            pressureEdgeBonds_.push_back({findBond(bonds_, t[0], t[1]),
+                                          findBond(bonds_, t[1], t[2]),
+                                          findBond(bonds_, t[2], t[0])});
+    }
     assignBoundaries();
     x_ = x0_;
     perturb(sheet.perturbationAmplitude, sheet.perturbationSeed);
@@ -50,6 +58,7 @@ void Membrane::computeBondScales(const MembraneParams& params) {
     if (interiorWeightedVolume <= 0.0)
         throw std::invalid_argument(
             "no particle has a bond with non-zero weight: raise the horizon");
+    if (params.material.surfaceCorrection) applySurfaceCorrection();
     const MaterialParams& m = params.material;
     const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
                            : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
@@ -71,6 +80,23 @@ void Membrane::computeBondScales(const MembraneParams& params) {
     const double waveSpeed = params.sheet.dx * std::sqrt(worstRatio);
     speedLimit_ = 100.0 * waveSpeed + 10.0 * boundarySpeed +
                   2.0 * params.gravity.norm() * params.time.duration + 1e-6;
+}
+
+void Membrane::applySurfaceCorrection() {
+    const int n = particleCount();
+    std::vector<double> factor(n);
+    const double interior = interiorFamilySum(
+        bonds_, [&](int b) { return bonds_.weight[b] * volume_[bonds_.partners[b]]; });
+    for (int i = 0; i < n; ++i) {
+        double sum = 0.0;
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            sum += bonds_.weight[b] * volume_[bonds_.partners[b]];
+        factor[i] = sum > 0.0 ? interior / sum : 1.0;
+    }
+    // The mean of both ends keeps the bond symmetric, so forces stay equal and opposite.
+    for (int i = 0; i < n; ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            bondScale_[b] *= 0.5 * (factor[i] + factor[bonds_.partners[b]]);
 }
 
 void Membrane::setUpFracture(const MembraneParams& params) {
@@ -206,6 +232,34 @@ bool Membrane::isBad(int i) const {
     return !(v_[i].squaredNorm() <= speedLimit_ * speedLimit_) || !x_[i].allFinite();
 }
 
+void Membrane::kick(double h, double tNext) {
+    const int n = particleCount();
+    const Eigen::Vector3d gravity = params_.gravity;
+    const double damping = params_.damping;
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        const std::int16_t c = constraint_[i];
+        if (c == kFree)
+            v_[i] += h * (force_[i] / mass_[i] + gravity - damping * v_[i]);
+        else if (c == kPinned)
+            v_[i].setZero();
+        else
+            v_[i] = boundaryVelocity(c, tNext);
+    }
+}
+
+void Membrane::checkFinite() {
+    const int n = particleCount();
+    bool bad = false;
+#pragma omp parallel for schedule(static) reduction(|| : bad) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) bad = bad || isBad(i);
+    if (!bad) return;
+    time_ += dt_;
+    ++steps_;
+    reportBlowUp();
+}
+
+// Eq. 26 in one pass per particle: velocity, position and the blow-up check together.
 void Membrane::integrate() {
     const int n = particleCount();
     const double dt = dt_;
@@ -225,17 +279,64 @@ void Membrane::integrate() {
         x_[i] += dt * v_[i];
         bad = bad || isBad(i);
     }
-    if (bad) {
-        time_ = tNext;
-        ++steps_;
-        reportBlowUp();
+    if (!bad) return;
+    time_ = tNext;
+    ++steps_;
+    reportBlowUp();
+}
+
+void Membrane::accumulateForces() {
+    bondForces<true>(force_);
+    if (!pressureEdgeBonds_.empty()) addPressure(force_);
+}
+
+// Follower pressure: each intact triangle pushes its three corners along its current area
+// vector, p A n / 3 each. A serial loop in triangle order keeps the sums identical for any
+// thread count; it runs only when a scene sets a pressure.
+void Membrane::addPressure(std::vector<Eigen::Vector3d>& force) const {
+    const auto& triangles = lattice_.triangles;
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const auto& e = pressureEdgeBonds_[t];
+        if ((e[0] >= 0 && !bonds_.alive[e[0]]) || (e[1] >= 0 && !bonds_.alive[e[1]]) ||
+            (e[2] >= 0 && !bonds_.alive[e[2]]))
+            continue;
+        const auto& [a, b, c] = triangles[t];
+        const Eigen::Vector3d area = 0.5 * (x_[b] - x_[a]).cross(x_[c] - x_[a]);
+        const Eigen::Vector3d share = params_.pressure * area / 3.0;
+        force[a] += share;
+        force[b] += share;
+        force[c] += share;
     }
 }
 
-void Membrane::step() {
-    bondForces<true>(force_);
+void Membrane::stepSymplecticEuler() {
+    accumulateForces();  // at x^n
     integrate();
-    if (diffusion_) diffusion_->advance(theta_, bonds_, time_, dt_);  // theta^n -> theta^n+1
+    forcesCurrent_ = false;
+}
+
+void Membrane::stepVelocityVerlet() {
+    const int n = particleCount();
+    const double dt = dt_;
+    if (!forcesCurrent_) accumulateForces();  // at x^n, unless the last step left them
+    kick(0.5 * dt, time_ + dt);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
+    accumulateForces();  // at x^n+1
+    kick(0.5 * dt, time_ + dt);
+    forcesCurrent_ = true;
+    checkFinite();
+}
+
+void Membrane::step() {
+    if (params_.time.integrator == Integrator::VelocityVerlet)
+        stepVelocityVerlet();
+    else
+        stepSymplecticEuler();
+    if (diffusion_) {
+        diffusion_->advance(theta_, bonds_, time_, dt_);  // theta^n -> theta^n+1
+        forcesCurrent_ = false;
+    }
     time_ += dt_;
     ++steps_;
 }

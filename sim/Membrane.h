@@ -6,6 +6,7 @@
 // symplectic Euler scheme of eq. 26 (velocity first, then position).
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -84,10 +85,20 @@ public:
 
     FrameView view(int frame) const;
 
-    std::vector<Eigen::Vector3d>& positions() { return x_; }
-    std::vector<Eigen::Vector3d>& velocities() { return v_; }
+    // Writable state: the caller may change it, so cached forces are recomputed next step.
+    std::vector<Eigen::Vector3d>& positions() {
+        forcesCurrent_ = false;
+        return x_;
+    }
+    std::vector<Eigen::Vector3d>& velocities() {
+        forcesCurrent_ = false;
+        return v_;
+    }
     const std::vector<Eigen::Vector3d>& velocities() const { return v_; }
-    std::vector<double>& theta() { return theta_; }  ///< empty without diffusion
+    std::vector<double>& theta() {  ///< empty without diffusion
+        forcesCurrent_ = false;
+        return theta_;
+    }
     const std::vector<double>& theta() const { return theta_; }
     const std::vector<double>& damage() const { return damage_; }
     /// Whether any bond can break or soften (fracture energy, elastoplastic law or notches).
@@ -105,6 +116,14 @@ private:
     static constexpr std::int16_t kPinned = -2;
 
     void computeBondScales(const MembraneParams& params);
+    void applySurfaceCorrection();
+    void accumulateForces();  ///< bonds (updating their state) and pressure into force_
+    void addPressure(std::vector<Eigen::Vector3d>& force) const;
+    void stepSymplecticEuler();
+    void stepVelocityVerlet();
+    /// v += h * acceleration for free particles; prescribed velocities for the others.
+    void kick(double h, double tNext);
+    void checkFinite();
     void setUpFracture(const MembraneParams& params);
     template <bool kUpdateBonds>
     void bondForces(std::vector<Eigen::Vector3d>& force);
@@ -147,6 +166,8 @@ private:
     std::vector<PlasticState> plastic_;     ///< per bond; empty unless the law is elastoplastic
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
+    std::vector<std::array<int, 3>> pressureEdgeBonds_;  ///< per rest triangle; empty if p = 0
+    bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
 };
 
 }  // namespace rend::sim

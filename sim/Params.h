@@ -81,6 +81,10 @@ struct MaterialParams {
     /// scale by max(0, 1 - loss * theta_bar).
     double stiffnessLoss = 0.0;
     double strengthLoss = 0.0;
+    /// Surface correction: scale each bond by the mean of its ends' factors S_interior / S_i
+    /// (S = sum_j W0 V_j), so particles that miss part of their family near a free edge are as
+    /// stiff as interior ones (the "energy method" of peridynamic surface corrections).
+    bool surfaceCorrection = false;
 };
 
 /// A pre-notch: a polyline in rest coordinates (x, y); every bond crossing it is broken at set-up.
@@ -132,7 +136,12 @@ struct BoundaryCondition {
     double rampTime = 0.0;              ///< seconds to reach full speed, linear ramp from rest
 };
 
+/// Explicit schemes: eq. 26's symplectic Euler (velocity, then position), or velocity Verlet
+/// (half kick, drift, new forces, half kick), second order and better at conserving energy.
+enum class Integrator { SymplecticEuler, VelocityVerlet };
+
 struct TimeParams {
+    Integrator integrator = Integrator::SymplecticEuler;
     std::optional<double> dt;  ///< nullopt: "auto", safety * the Silling-Askari bound
     double safety = 0.8;       ///< Peridigm uses 0.8-0.85
     double duration = 5.0;     ///< simulated seconds
@@ -145,7 +154,8 @@ struct MembraneParams {
     MaterialParams material;
     std::vector<BoundaryCondition> boundaries;
     Eigen::Vector3d gravity{0, 0, 0};
-    double damping = 0.0;  ///< mass-proportional velocity damping [1/s]
+    double damping = 0.0;   ///< mass-proportional velocity damping [1/s]
+    double pressure = 0.0;  ///< uniform follower pressure on the intact surface, +z side [Pa]
     TimeParams time;
     std::vector<Notch> notches;
     DiffusionParams diffusion;

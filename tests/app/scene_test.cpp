@@ -424,7 +424,7 @@ TEST_F(SceneTest, SetValuesAreCheckedLikeFileValues) {
 TEST_F(SceneTest, SetOfAnUnknownKeyIsRejected) {
     EXPECT_EQ(errorOf(kStretch, {"time.dtt=1e-4"}),
               "--set 'time.dtt=1e-4': error: unknown key 'dtt' in [time]; expected one of: dt, "
-              "safety, duration, fps, allow_unstable. Did you mean 'dt'?");
+              "safety, duration, fps, allow_unstable, integrator. Did you mean 'dt'?");
     EXPECT_NE(errorOf(kStretch, {"rendr.width=5"}).find("unknown key 'rendr'"), std::string::npos);
 }
 

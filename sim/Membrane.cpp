@@ -82,21 +82,50 @@ void Membrane::computeBondScales(const MembraneParams& params) {
                   2.0 * params.gravity.norm() * params.time.duration + 1e-6;
 }
 
+namespace {
+
+// Strain energy density of particle i under unit uniaxial stress along axis a, up to a constant
+// common to all particles: sum_j W0 V_j |xi| s^2 (the linear law's micropotential c s^2 |xi| / 2),
+// with the bond stretch s = n.eps.n of the plane-stress strain eps = a a - (1/3) a' a' (nu = 1/3)
+// and W0 V_j |xi| written through the bond scale W0 V_i V_j / |xi| of equal particle volumes.
+double uniaxialStressEnergy(const BondFamilies& bonds, const std::vector<double>& bondScale,
+                            const std::vector<Eigen::Vector3d>& x0, int i, int a) {
+    double sum = 0.0;
+    for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+        const Eigen::Vector3d n = (x0[bonds.partners[b]] - x0[i]) / bonds.restLength[b];
+        const double along = n[a] * n[a];
+        const double s = along - (1.0 - along) / 3.0;
+        sum += bondScale[b] * bonds.restLength[b] * bonds.restLength[b] * s * s;
+    }
+    return sum;
+}
+
+}  // namespace
+
 void Membrane::applySurfaceCorrection() {
     const int n = particleCount();
-    std::vector<double> factor(n);
-    const double interior = interiorFamilySum(
-        bonds_, [&](int b) { return bonds_.weight[b] * volume_[bonds_.partners[b]]; });
-    for (int i = 0; i < n; ++i) {
-        double sum = 0.0;
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-            sum += bonds_.weight[b] * volume_[bonds_.partners[b]];
-        factor[i] = sum > 0.0 ? interior / sum : 1.0;
+    // Energy method (Madenci & Oterkus 2014, Sec. 4.2) with uniaxial stress, not strain, as the
+    // loading: an edge is free of stress across it, so that is the state its particles meet.
+    std::vector<Eigen::Vector2d> factor(n, Eigen::Vector2d::Ones());
+    for (int a = 0; a < 2; ++a) {
+        std::vector<double> energy(n);
+        double interior = 0.0;
+        for (int i = 0; i < n; ++i) {
+            energy[i] = uniaxialStressEnergy(bonds_, bondScale_, x0_, i, a);
+            interior = std::max(interior, energy[i]);
+        }
+        for (int i = 0; i < n; ++i)
+            if (energy[i] > 0.0) factor[i][a] = interior / energy[i];
     }
-    // The mean of both ends keeps the bond symmetric, so forces stay equal and opposite.
+    // The ends' mean keeps the bond symmetric (equal and opposite forces); the ellipse through
+    // the x and y factors gives the factor along the bond's direction n.
     for (int i = 0; i < n; ++i)
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-            bondScale_[b] *= 0.5 * (factor[i] + factor[bonds_.partners[b]]);
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            const Eigen::Vector3d d = (x0_[j] - x0_[i]) / bonds_.restLength[b];
+            const Eigen::Vector2d g = 0.5 * (factor[i] + factor[j]);
+            bondScale_[b] /= std::hypot(d.x() / g.x(), d.y() / g.y());
+        }
 }
 
 void Membrane::setUpFracture(const MembraneParams& params) {

@@ -94,6 +94,7 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"particles\": " << s.particles << ",\n  \"bonds\": " << s.bonds << ",\n"
       << "  \"dt\": " << s.dt << ",\n  \"stable_dt\": " << s.stableDt << ",\n"
       << "  \"substeps_per_frame\": " << s.substeps << ",\n  \"steps\": " << s.steps << ",\n"
+      << "  \"extra_substeps\": " << s.extraSubsteps << ",\n"
       << "  \"frames_simulated\": " << s.framesSimulated << ",\n"
       << "  \"frames_written\": " << s.framesWritten << ",\n"
       << "  \"threads\": " << omp_get_max_threads() << ",\n"
@@ -164,6 +165,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
 
     auto finish = [&](const std::string& status) {
         s.steps = membrane.stepCount();
+        s.extraSubsteps = membrane.extraSubsteps();
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
         stats.finish();

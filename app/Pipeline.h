@@ -34,6 +34,7 @@ struct RunSummary {
     double stableDt = 0.0;
     int substeps = 0;  ///< explicit steps per frame
     long steps = 0;
+    long extraSubsteps = 0;  ///< pieces the power law's stiffening cut steps into, beyond steps
     int framesSimulated = 0;
     int framesWritten = 0;
     StageTimes seconds;

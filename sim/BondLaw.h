@@ -114,6 +114,15 @@ struct BondLaw {
         }
     }
 
+    /// df/deta of the power law over its rest value c: it grows as s^-4 in compression, so
+    /// the explicit step must shrink with it (Membrane::step sub-steps by its square root).
+    double powerLawStiffening(double eta) const {
+        const double s = 1.0 + eta, s2 = s * s;
+        const double tangent = 2.0 * powerC * (1.0 + 3.0 / (s2 * s2)) +
+                               powerCStar * powerN * (powerN - 1.0) * power(s, powerN - 2.0);
+        return tangent / c;
+    }
+
     double force(double eta, const PlasticState& p = {}) const {
         switch (kind) {
             case BondLawKind::Linear:

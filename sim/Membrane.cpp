@@ -189,7 +189,8 @@ void Membrane::bondForcesFor(std::vector<Eigen::Vector3d>& force) {
     force.resize(n);
     const auto& offsets = bonds_.offsets;
     const MaterialParams& m = params_.material;
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
+#pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         const Eigen::Vector3d xi = x_[i];
@@ -217,12 +218,18 @@ void Membrane::bondForcesFor(std::vector<Eigen::Vector3d>& force) {
                 state = law_.yieldStep(eta, plastic_[b]);
                 if constexpr (kUpdateBonds) plastic_[b] = state;
             }
+            if constexpr (kLaw == BondLawKind::PowerLaw) {  // where the strain will be in dt
+                const double rate = r.dot(v_[j] - v_[i]) / (length * bonds_.restLength[b]);
+                lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
+            }
             double f = law_.forceAs<kLaw>(eta, state);
             if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
             sum += (bondScale_[b] * f / length) * r;
         }
         force[i] = sum;
     }
+    if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw)
+        stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
 }
 
 template <bool kUpdateBonds>
@@ -289,10 +296,8 @@ void Membrane::checkFinite() {
 }
 
 // Eq. 26 in one pass per particle: velocity, position and the blow-up check together.
-void Membrane::integrate() {
+void Membrane::integrate(double dt, double tNext) {
     const int n = particleCount();
-    const double dt = dt_;
-    const double tNext = time_ + dt;
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
     bool bad = false;
@@ -338,21 +343,41 @@ void Membrane::addPressure(std::vector<Eigen::Vector3d>& force) const {
     }
 }
 
+int Membrane::piecesOfStep() {
+    if (stiffening_ <= 1.0) return 1;
+    // The bound scales as 1/sqrt(stiffness): keep dt / bound what it was at rest.
+    const int pieces = int(std::min(std::ceil(std::sqrt(stiffening_)), double(kMaxPieces)));
+    subSteps_ += pieces - 1;
+    return pieces;
+}
+
 void Membrane::stepSymplecticEuler() {
     accumulateForces();  // at x^n
-    integrate();
+    const int pieces = piecesOfStep();
+    double done = 0.0;
+    for (int k = 0; k < pieces; ++k) {
+        if (k > 0) accumulateForces();
+        const double h = (dt_ - done) / (pieces - k);
+        integrate(h, time_ + done + h);
+        done += h;
+    }
     forcesCurrent_ = false;
 }
 
 void Membrane::stepVelocityVerlet() {
     const int n = particleCount();
-    const double dt = dt_;
     if (!forcesCurrent_) accumulateForces();  // at x^n, unless the last step left them
-    kick(0.5 * dt, time_ + dt);
+    const int pieces = piecesOfStep();
+    double done = 0.0;
+    for (int k = 0; k < pieces; ++k) {
+        const double h = (dt_ - done) / (pieces - k);
+        kick(0.5 * h, time_ + done + h);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
-    accumulateForces();  // at x^n+1
-    kick(0.5 * dt, time_ + dt);
+        for (int i = 0; i < n; ++i) x_[i] += h * v_[i];
+        accumulateForces();  // at x^n+1
+        kick(0.5 * h, time_ + done + h);
+        done += h;
+    }
     forcesCurrent_ = true;
     checkFinite();
 }

@@ -58,6 +58,8 @@ public:
     void setTimeStep(double dt) { dt_ = dt; }
     double time() const { return time_; }
     long stepCount() const { return steps_; }
+    /// Extra pieces steps were cut into because the power law stiffened in compression.
+    long extraSubsteps() const { return subSteps_; }
 
     /// One explicit step (eq. 26): bond forces (breaking bonds past eta_c, yielding
     /// elastoplastic ones), then velocities, then positions, then theta. Throws
@@ -139,7 +141,10 @@ private:
     void assignBoundaries();
     void perturb(double amplitude, std::uint64_t seed);
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
-    void integrate();
+    /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
+    void integrate(double h, double tNext);
+    /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
+    int piecesOfStep();
     [[noreturn]] void reportBlowUp() const;
     bool isBad(int i) const;
 
@@ -157,6 +162,9 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     double speedLimit_ = 0.0;
+    double stiffening_ = 1.0;  ///< power law: df/deta of the most compressed bond over c
+    long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
+    static constexpr int kMaxPieces = 64;
 
     // Structure of arrays: one contiguous array per attribute.
     std::vector<Eigen::Vector3d> x_, v_, x0_, force_;

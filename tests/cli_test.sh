@@ -76,7 +76,7 @@ check "short run" run 0 run scenes/stretch.toml "${small[@]}" --out "$tmp/ok" \
     --set render.width=160 --set render.height=90
 check "six frames written" test "$(ls "$tmp/ok/frames" | grep -c '^frame_000[1-6].png$')" -eq 6
 check "stats has a row per frame" test "$(wc -l <"$tmp/ok/stats.csv")" -eq 7
-check "run.json is JSON" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['status']=='ok' and d['particles']>0 and d['ns_per_particle_step']>0" "$tmp/ok/run.json"
+check "run.json is JSON" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['status']=='ok' and d['particles']>0 and d['ns_per_particle_step']>0 and d['extra_substeps']==0" "$tmp/ok/run.json"
 check "short run leaves no partial files" no_partial_files "$tmp/ok"
 check "frames option" run 0 run scenes/stretch.toml "${small[@]}" --out "$tmp/range" \
     --frames 5-6 --set render.width=32 --set render.height=32

@@ -218,9 +218,11 @@ void Membrane::bondForcesFor(std::vector<Eigen::Vector3d>& force) {
                 state = law_.yieldStep(eta, plastic_[b]);
                 if constexpr (kUpdateBonds) plastic_[b] = state;
             }
-            if constexpr (kLaw == BondLawKind::PowerLaw) {  // where the strain will be in dt
-                const double rate = r.dot(v_[j] - v_[i]) / (length * bonds_.restLength[b]);
-                lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
+            if constexpr (kLaw == BondLawKind::PowerLaw) {
+                if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
+                    const double rate = r.dot(v_[j] - v_[i]) / (length * bonds_.restLength[b]);
+                    lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
+                }
             }
             double f = law_.forceAs<kLaw>(eta, state);
             if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
@@ -345,8 +347,11 @@ void Membrane::addPressure(std::vector<Eigen::Vector3d>& force) const {
 
 int Membrane::piecesOfStep() {
     if (stiffening_ <= 1.0) return 1;
-    // The bound scales as 1/sqrt(stiffness): keep dt / bound what it was at rest.
-    const int pieces = int(std::min(std::ceil(std::sqrt(stiffening_)), double(kMaxPieces)));
+    // The bound scales as 1/sqrt(stiffness). Keep dt / bound within what was allowed at rest:
+    // the safety factor, or the step's own ratio when it was set higher.
+    const double allowed = std::max(params_.time.safety, dt_ / stableDt_) * stableDt_;
+    const double needed = std::ceil(dt_ * std::sqrt(stiffening_) / allowed * (1.0 - 1e-12));
+    const int pieces = int(std::clamp(needed, 1.0, double(kMaxPieces)));
     subSteps_ += pieces - 1;
     return pieces;
 }

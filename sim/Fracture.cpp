@@ -1,5 +1,6 @@
 #include "sim/Fracture.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -21,21 +22,16 @@ double orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
     return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
 }
 
-bool onSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
-    return p.x() >= std::min(a.x(), b.x()) && p.x() <= std::max(a.x(), b.x()) &&
-           p.y() >= std::min(a.y(), b.y()) && p.y() <= std::max(a.y(), b.y());
-}
-
 }  // namespace
 
 bool segmentsCross(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& a,
                    const Eigen::Vector2d& b) {
-    const double d1 = orientation(a, b, p), d2 = orientation(a, b, q);
-    const double d3 = orientation(p, q, a), d4 = orientation(p, q, b);
-    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
-        return true;
-    return (d1 == 0 && onSegment(a, b, p)) || (d2 == 0 && onSegment(a, b, q)) ||
-           (d3 == 0 && onSegment(p, q, a)) || (d4 == 0 && onSegment(p, q, b));
+    // A point exactly on the other segment's line counts as lying on its left (>= 0): a notch
+    // drawn along a lattice row then cuts that row off from the row below, once, instead of
+    // cutting every bond that touches it and leaving the row's particles loose.
+    const bool pLeft = orientation(a, b, p) >= 0, qLeft = orientation(a, b, q) >= 0;
+    const bool aLeft = orientation(p, q, a) >= 0, bLeft = orientation(p, q, b) >= 0;
+    return pLeft != qLeft && aLeft != bLeft;
 }
 
 namespace {
@@ -55,8 +51,11 @@ std::size_t applyNotches(std::span<const Notch> notches, std::span<const Eigen::
     std::size_t broken = 0;
     for (int i = 0; i < bonds.particleCount(); ++i)
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
-            if (bonds.alive[b] &&
-                crossesAnyNotch(rest[i].head<2>(), rest[bonds.partners[b]].head<2>(), notches)) {
+            // Both copies of a bond are tested with the lower index first, so they agree even
+            // where the tie-break of segmentsCross decides.
+            if (const int lo = std::min(i, bonds.partners[b]), hi = std::max(i, bonds.partners[b]);
+                bonds.alive[b] &&
+                crossesAnyNotch(rest[lo].head<2>(), rest[hi].head<2>(), notches)) {
                 bonds.alive[b] = 0;
                 ++broken;
             }

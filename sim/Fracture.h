@@ -30,7 +30,8 @@ double calibratedCriticalStretch(double fractureEnergy, double micromodulus,
 /// Eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R)).
 double paperCriticalStretch(double fractureEnergy, double youngsModulus, double horizon);
 
-/// Whether segments pq and ab cross (touching at an end point counts).
+/// Whether segments pq and ab cross. A point exactly on the other segment's line counts as on
+/// its left, so a notch along a lattice row cuts the bonds below that row and no others.
 bool segmentsCross(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& a,
                    const Eigen::Vector2d& b);
 

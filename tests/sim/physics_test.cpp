@@ -196,6 +196,39 @@ TEST(Fracture, ANotchBreaksExactlyTheBondsItCrosses) {
     EXPECT_GE(expected / 2, 18u) << "about two bonds per dx of notch";
 }
 
+TEST(Fracture, ANotchAlongAParticleRowCutsTheRowOffOnceAndLeavesNoLooseParticle) {
+    // A notch drawn exactly through a row of particles (y = 0 on an odd number of rows): the
+    // bonds between that row and the row below break, the row stays bonded to the row above.
+    MembraneParams p = sheet(0.4);
+    p.sheet.size = {0.4, 0.02 * std::sqrt(3.0) / 2 * 20};  // 21 rows, the middle one at y = 0
+    Membrane probe(p);
+    int onLine = 0;
+    for (const auto& x : probe.restPositions()) onLine += std::abs(x.y()) < 1e-12;
+    ASSERT_GT(onLine, 10) << "the set-up needs a row at y = 0";
+    p.notches = {Notch{{{-0.105, 0.0}, {0.105, 0.0}}}};
+    Membrane m(p);
+    const BondFamilies& bonds = m.bonds();
+    std::size_t expected = 0;
+    for (int i = 0; i < m.particleCount(); ++i) {
+        const Eigen::Vector3d a = m.restPositions()[i];
+        int alive = 0;
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            const Eigen::Vector3d c = m.restPositions()[bonds.partners[b]];
+            const Eigen::Vector3d lo = a.y() < c.y() ? a : c, hi = a.y() < c.y() ? c : a;
+            // Independent of the code under test: the bond joins the row to the one below, and
+            // its upper end lies on the notch.
+            const bool crosses =
+                std::abs(hi.y()) < 1e-12 && lo.y() < -1e-12 && std::abs(hi.x()) <= 0.105;
+            EXPECT_EQ(bonds.alive[b] == 0, crosses) << i << " -> " << bonds.partners[b];
+            expected += crosses;
+            alive += bonds.alive[b];
+        }
+        EXPECT_GE(alive, 2) << "particle " << i << " was cut loose";
+    }
+    EXPECT_EQ(m.notchedBondCount(), expected / 2);
+    EXPECT_EQ(expected / 2, 2u * 11) << "two bonds down from each of the 11 particles on it";
+}
+
 TEST(Diffusion, InsulatedSheetWithoutSourcesConservesTheTotal) {
     MembraneParams p = sheet(0.4);
     p.material.conductivity = 50.0;

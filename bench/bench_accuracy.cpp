@@ -4,11 +4,12 @@
 // meets a tolerance. A setting is "family/label": scripts/plot_bench.py draws one line per
 // family. Where the error does not fall monotonically within a family, a `# note:` line says why.
 //
-//   bench_accuracy [out.csv]      (stdout always; the file too when given)
+//   bench_accuracy [out.csv] [--only CASE]   (stdout always; the file too when given)
 
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,92 +19,13 @@
 #include <string>
 #include <vector>
 
+#include "bench/accuracy/Report.h"
 #include "sim/Membrane.h"
 
 using namespace rend::sim;
+using namespace rend::bench;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string fmt(const char* format, double value) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, format, value);
-    return buffer;
-}
-
-/// Runs `run` (returning a struct whose first member is its wall seconds) and, when it is short,
-/// repeats it and keeps the fastest: other processes on the machine add noise, never speed.
-template <class Run>
-auto timed(Run run) {
-    auto best = run();
-    double spent = best.seconds;
-    for (int k = 0; k < 4 && spent < 1.0; ++k) {
-        auto again = run();
-        spent += again.seconds;
-        if (again.seconds < best.seconds) best = again;
-    }
-    return best;
-}
-
-std::string loadAverage() {
-    std::ifstream in("/proc/loadavg");
-    double one = 0.0;
-    in >> one;
-    return in ? fmt("%.2f", one) : std::string("unknown");
-}
-
-struct Point {
-    std::string label;
-    double seconds;
-    double error;
-};
-
-/// A sweep from coarse to fine; `why` explains in advance what limits it, printed only if the
-/// error fails to fall (the sweep's own diagnostics are appended by the case).
-struct Family {
-    std::string caseName;
-    std::string name;
-    std::vector<Point> points;
-    std::string why;
-};
-
-/// Collects every row so the file gets the same text as stdout.
-class Report {
-public:
-    void line(const std::string& text) {
-        std::printf("%s\n", text.c_str());
-        std::fflush(stdout);  // rows appear as they are measured: the run takes minutes
-        text_ += text + "\n";
-    }
-    void row(const Family& f, const Point& p) {
-        line(f.caseName + "," + f.name + "/" + p.label + "," + fmt("%.4g", p.seconds) + "," +
-             fmt("%.4e", p.error));
-    }
-    /// Refinement must lower the error at every step; otherwise, or when the last step gains
-    /// under 10% (the sweep has hit a floor), say where and why.
-    void checkMonotone(const Family& f) {
-        for (std::size_t k = 1; k < f.points.size(); ++k)
-            if (!(f.points[k].error < f.points[k - 1].error)) {
-                line("# note: " + f.caseName + " " + f.name + ": error does not fall from " +
-                     f.points[k - 1].label + " (" + fmt("%.3e", f.points[k - 1].error) + ") to " +
-                     f.points[k].label + " (" + fmt("%.3e", f.points[k].error) + "): " + f.why);
-                return;
-            }
-        const std::size_t n = f.points.size();
-        if (n >= 2 && f.points[n - 1].error > 0.9 * f.points[n - 2].error)
-            line("# note: " + f.caseName + " " + f.name + ": falls but saturates at " +
-                 fmt("%.3e", f.points[n - 1].error) + ": " + f.why);
-    }
-    const std::string& text() const { return text_; }
-
-private:
-    std::string text_;
-};
 
 int nearestParticle(const Membrane& m, const Eigen::Vector2d& at) {
     int best = 0;
@@ -381,6 +303,13 @@ void diffusionCase(Report& report) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    std::string only, csv;  // bench_accuracy [out.csv] [--only CASE]
+    for (int k = 1; k < argc; ++k) {
+        if (std::string(argv[k]) == "--only" && k + 1 < argc)
+            only = argv[++k];
+        else
+            csv = argv[k];
+    }
     // One thread: wall times then compare settings fairly even on a shared machine, where
     // spinning OpenMP threads that lose their core make multi-threaded timings erratic.
     omp_set_num_threads(1);
@@ -389,16 +318,20 @@ int main(int argc, char** argv) {
     report.line("case,setting,wall_seconds,error");
     // Wall times are only comparable on an idle machine: say how busy it was.
     report.line("# 1 thread; load average at start " + loadAverage());
-    patchCase(report);
-    waveCase(report);
-    diffusionCase(report);
+    std::vector<CaseEntry> cases = {
+        {10, "patch", &patchCase}, {20, "wave", &waveCase}, {30, "diffusion", &diffusionCase}};
+    cases.insert(cases.end(), registeredCases().begin(), registeredCases().end());
+    std::sort(cases.begin(), cases.end(),
+              [](const CaseEntry& a, const CaseEntry& b) { return a.order < b.order; });
+    for (const CaseEntry& c : cases)
+        if (only.empty() || only == c.name) c.run(report);
     report.line("# total wall time " + fmt("%.1f", secondsSince(start)) +
                 " s, load average at end " + loadAverage());
-    if (argc > 1) {
-        std::ofstream out(argv[1]);
+    if (!csv.empty()) {
+        std::ofstream out(csv);
         out << report.text();
         if (!out) {
-            std::fprintf(stderr, "error: cannot write %s\n", argv[1]);
+            std::fprintf(stderr, "error: cannot write %s\n", csv.c_str());
             return 1;
         }
     }

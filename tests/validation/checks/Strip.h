@@ -1,0 +1,42 @@
+#pragma once
+// VALIDATION.md, patch test: "edge softening reported and corrected to <= 3%".
+//
+// The skin effect is measured where a user meets it: a narrow strip pulled along its length.
+// A continuum strip of width W carries F = E W h e at strain e whatever W is; a particle strip
+// whose edge particles miss bonds carries less, E_strip = E (1 - 2 d / N) for N cells across,
+// where d is the stiffness the outermost row lacks, in cells. Each particle owns a cell of area
+// dx * rowSpacing (the lattice's convention: its mass is rho h times that), so W = N cells.
+//
+// The strip is solved statically: sliding grips at both ends impose u_x = e x (u_y free), the
+// rest is relaxed by conjugate gradients on the real force loop (Membrane::computeForces, linear
+// at strain 1e-6), then E_strip = reaction / (h W e_mid) with e_mid fitted over the middle half,
+// away from the grips. The outermost row's modulus 1 - d is read from two widths.
+
+#include "sim/Membrane.h"
+
+namespace rend::checks {
+
+constexpr double kStripModulus = 2e4;  ///< E of the strips [Pa]
+
+struct Strip {
+    bool alongX = true;  ///< hexagonal rows are straight along x and zig-zag along y
+    int cells = 8;       ///< N across the strip
+    double horizonFactor = 1.5;
+    bool surfaceCorrection = false;
+    double dx = 0.01;
+};
+
+sim::MembraneParams stripParams(const Strip& s);
+
+/// E_strip / E of the strip under uniaxial stress along its length.
+double stripModulus(const Strip& s);
+
+struct SkinFigures {
+    double strip;     ///< E_strip / E at N = 5 R / dx cells
+    double outerRow;  ///< 1 - d: the outermost row's modulus, from N and 2N
+    double interior;  ///< E_inf / E
+};
+
+SkinFigures skin(bool alongX, double horizonFactor, bool corrected);
+
+}  // namespace rend::checks

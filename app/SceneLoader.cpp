@@ -788,6 +788,34 @@ void readOutput(const TableReader& root, Scene& scene) {
     }
 }
 
+// `solver = "..."` at the top level. The FEM and mass-spring solvers carry no fracture, bond
+// law or diffusion coupling yet: a scene asking for those with them is refused, not silently
+// run without.
+void readSolver(const TableReader& root, sim::MembraneParams& p) {
+    constexpr Param kSolver{"solver", "the discretisation of the membrane", "\"fem_cst\""};
+    static constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
+                                                    "mass_spring_tp"};
+    p.solver = sim::SolverKind(root.choice(kSolver, kSolvers).value_or(std::size_t(p.solver)));
+    if (p.solver == sim::SolverKind::Peridynamic) return;
+    const sim::MaterialParams& m = p.material;
+    std::vector<std::string> wanted;
+    if (m.law != sim::BondLawKind::Linear) wanted.push_back("a bond law other than linear");
+    if (m.fractureEnergy) wanted.push_back("fracture (material.fracture_energy)");
+    if (!p.notches.empty()) wanted.push_back("notches");
+    if (m.expansion != 0.0 || m.stiffnessLoss != 0.0 || m.strengthLoss != 0.0)
+        wanted.push_back("diffusion coupling (expansion, stiffness_loss, strength_loss)");
+    if (m.surfaceCorrection) wanted.push_back("surface_correction");
+    std::string needs;
+    for (std::size_t k = 0; k < wanted.size(); ++k)
+        needs += (k == 0 ? "" : k + 1 == wanted.size() ? " and " : ", ") + wanted[k];
+    if (needs.empty()) return;
+    root.fail(kSolver.key, "\"peridynamic\" for a scene with " + needs,
+              "\"" + std::string(kSolvers[std::size_t(p.solver)]) + "\"",
+              "Only the peridynamic solver has " + needs +
+                  " so far; remove it or use "
+                  "solver = \"peridynamic\".");
+}
+
 std::string toJson(const toml::table& document) {
     std::ostringstream out;
     out << toml::json_formatter{document};
@@ -809,8 +837,8 @@ std::filesystem::path assetsDirectory() {
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     const toml::table document = scene::buildSceneDocument(file, overrides, assetsDirectory());
     const TableReader root(document, "", "the top-level table",
-                           {"sheet", "material", "boundary", "notch", "diffusion", "forces", "time",
-                            "camera", "light", "render", "output"});
+                           {"solver", "sheet", "material", "boundary", "notch", "diffusion",
+                            "forces", "time", "camera", "light", "render", "output"});
     Scene s;
     s.file = file;
     s.sim.sheet = readSheet(root);
@@ -819,6 +847,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     s.sim.notches = readNotches(root);
     s.sim.diffusion = readDiffusion(root, s.sim.sheet);
     readForces(root, s.sim);
+    readSolver(root, s.sim);
     s.dtLocation = readTime(root, s.sim.time);
     s.render.camera = readCamera(root, s.sim.sheet);
     readLight(root, s.render);

@@ -914,3 +914,21 @@ export = ["glb", "vdb"]
     EXPECT_DOUBLE_EQ(s.render.vdb.adaptivity, 0.5);
     EXPECT_EQ(s.exports, (std::vector<ExportFormat>{ExportFormat::Glb, ExportFormat::Vdb}));
 }
+
+TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
+    EXPECT_EQ(loadScene(kStretch).sim.solver, sim::SolverKind::Peridynamic) << "the default";
+    EXPECT_EQ(loadScene(kStretch, {"solver=fem_cst"}).sim.solver, sim::SolverKind::FemCst);
+    EXPECT_EQ(loadScene(kStretch, {"solver=mass_spring_vg"}).sim.solver,
+              sim::SolverKind::MassSpringVanGelder);
+    EXPECT_EQ(loadScene(kStretch, {"solver=mass_spring_tp"}).sim.solver,
+              sim::SolverKind::MassSpringTwoParameter);
+    const fs::path file = writeScene("minimal.toml", kMinimal);
+    EXPECT_NE(errorOf(file, {"solver=fem"}).find("solver: expected one of"), std::string::npos);
+    const std::string fracture = errorOf(file, {"solver=fem_cst", "material.fracture_energy=5"});
+    EXPECT_NE(fracture.find("solver: expected \"peridynamic\" for a scene with fracture"),
+              std::string::npos)
+        << fracture;
+    EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
+                  .find("a bond law other than linear"),
+              std::string::npos);
+}

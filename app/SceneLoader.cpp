@@ -22,7 +22,7 @@ using scene::Range;
 using scene::TableReader;
 
 // Each list follows its enum's order, so a choice's index converts straight to the enum.
-constexpr std::string_view kShapes[] = {"rectangle", "disc"};
+constexpr std::string_view kShapes[] = {"rectangle", "disc", "sphere"};
 constexpr std::string_view kLattices[] = {"hexagonal", "square"};
 constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
@@ -63,15 +63,18 @@ struct SheetExtent {
 };
 
 SheetExtent extentOf(const sim::SheetParams& sheet) {
-    const bool disc = sheet.outline == sim::Outline::Disc;
+    const bool round = sheet.outline != sim::Outline::Rectangle;
     const Eigen::Vector2d half =
-        disc ? Eigen::Vector2d(sheet.radius, sheet.radius) : Eigen::Vector2d(0.5 * sheet.size);
+        round ? Eigen::Vector2d(sheet.radius, sheet.radius) : Eigen::Vector2d(0.5 * sheet.size);
     SheetExtent e;
     e.min = sheet.center.head<2>() - half;
     e.max = sheet.center.head<2>() + half;
     e.smallest = 2 * half.minCoeff();
     e.largest = 2 * half.maxCoeff();
-    e.area = disc ? std::numbers::pi * sheet.radius * sheet.radius : sheet.size.prod();
+    const double r2 = sheet.radius * sheet.radius;
+    e.area = sheet.outline == sim::Outline::Disc     ? std::numbers::pi * r2
+             : sheet.outline == sim::Outline::Sphere ? 4.0 * std::numbers::pi * r2
+                                                     : sheet.size.prod();
     return e;
 }
 
@@ -90,7 +93,7 @@ void rejectForShape(const TableReader& t, std::string_view key, std::string_view
 void readOutline(const TableReader& t, sim::SheetParams& s) {
     constexpr Param kShape{"shape", "the sheet's outline", "\"rectangle\""};
     constexpr Param kSize{"size", "the rectangle's extent [x, y] in metres", "[2.0, 2.0]"};
-    constexpr Param kRadius{"radius", "the disc radius in metres", "1.0"};
+    constexpr Param kRadius{"radius", "the disc or sphere radius in metres", "1.0"};
     s.outline = sim::Outline(t.choice(kShape, kShapes).value_or(0));
     if (s.outline == sim::Outline::Rectangle) {
         if (!t.has(kSize.key)) t.missing(kSize, "2 numbers > 0");
@@ -98,7 +101,8 @@ void readOutline(const TableReader& t, sim::SheetParams& s) {
         rejectForShape(t, kRadius.key, "rectangle", "Remove radius, or set shape = \"disc\".");
     } else {
         s.radius = t.requiredNumber(kRadius, Range::positive());
-        rejectForShape(t, kSize.key, "disc", "Remove size and give radius instead.");
+        rejectForShape(t, kSize.key, kShapes[std::size_t(s.outline)],
+                       "Remove size and give radius instead.");
     }
 }
 

@@ -792,9 +792,9 @@ void readOutput(const TableReader& root, Scene& scene) {
     }
 }
 
-// `solver = "..."` at the top level. The FEM and mass-spring solvers carry no fracture, bond
-// law or diffusion coupling yet: a scene asking for those with them is refused, not silently
-// run without.
+// `solver = "..."` at the top level. The FEM and mass-spring solvers break by a critical strain
+// from fracture_energy, but carry no other bond law, no diffusion coupling and (FEM) no notches
+// yet: a scene asking for those with them is refused, not silently run without.
 void readSolver(const TableReader& root, sim::MembraneParams& p) {
     constexpr Param kSolver{"solver", "the discretisation of the membrane", "\"fem_cst\""};
     static constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
@@ -804,8 +804,9 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
     if (m.law != sim::BondLawKind::Linear) wanted.push_back("a bond law other than linear");
-    if (m.fractureEnergy) wanted.push_back("fracture (material.fracture_energy)");
-    if (!p.notches.empty()) wanted.push_back("notches");
+    if (m.criticalStretch == sim::CriticalStretchMode::Paper)
+        wanted.push_back("critical_stretch = \"paper\"");
+    if (!p.notches.empty() && p.solver == sim::SolverKind::FemCst) wanted.push_back("notches");
     if (m.expansion != 0.0 || m.stiffnessLoss != 0.0 || m.strengthLoss != 0.0)
         wanted.push_back("diffusion coupling (expansion, stiffness_loss, strength_loss)");
     if (m.surfaceCorrection) wanted.push_back("surface_correction");

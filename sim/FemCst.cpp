@@ -1,7 +1,9 @@
 #include "sim/FemCst.h"
 
 #include <cmath>
+#include <map>
 #include <stdexcept>
+#include <utility>
 
 #include "sim/Parallel.h"
 
@@ -19,14 +21,16 @@ void triangleIncidence(const std::vector<std::array<int, 3>>& triangles, int par
         for (int c = 0; c < 3; ++c) corners[fill[triangles[t][c]]++] = 3 * t + c;
 }
 
-FemCst::FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness)
-    : thickness_(thickness) {
+FemCst::FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness,
+               double criticalStrain)
+    : thickness_(thickness), criticalStrain_(criticalStrain) {
     if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
         throw std::invalid_argument("fem_cst needs -1 < poisson < 0.5");
     lambda_ = youngsModulus * poissonRatio / (1.0 - poissonRatio * poissonRatio);
     mu_ = youngsModulus / (2.0 * (1.0 + poissonRatio));
     const auto& p = lattice.positions;
-    for (const auto& t : lattice.triangles) {
+    for (int index = 0; index < int(lattice.triangles.size()); ++index) {
+        const auto& t = lattice.triangles[index];
         // Rest edges in the triangle's own plane (u along edge 01), so curved rest shapes such
         // as the sphere work; St. Venant-Kirchhoff is isotropic, so the frame is free.
         const Eigen::Vector3d e1 = p[t[1]] - p[t[0]], e2 = p[t[2]] - p[t[0]];
@@ -36,12 +40,27 @@ FemCst::FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio
         Dm << e1.dot(u), e2.dot(u), e1.dot(w), e2.dot(w);
         const double area = 0.5 * std::abs(Dm.determinant());
         if (area <= 0.0) continue;  // a degenerate rest triangle carries nothing
-        elements_.push_back({t, Dm.inverse(), area});
+        elements_.push_back({t, Dm.inverse(), area, index, {-1, -1, -1}});
     }
+    findNeighbours();
+    alive_.assign(elements_.size(), 1);
+    triangleAlive_.assign(lattice.triangles.size(), 1);
     std::vector<std::array<int, 3>> kept;
     for (const Element& e : elements_) kept.push_back(e.v);
     triangleIncidence(kept, int(p.size()), cornerOffsets_, corners_);
     cornerForce_.resize(3 * elements_.size());
+}
+
+void FemCst::findNeighbours() {
+    std::map<std::pair<int, int>, std::pair<int, int>> side;  // edge -> (element, side)
+    for (int e = 0; e < int(elements_.size()); ++e)
+        for (int s = 0; s < 3; ++s) {
+            const auto key = std::minmax(elements_[e].v[(s + 1) % 3], elements_[e].v[(s + 2) % 3]);
+            const auto [it, added] = side.try_emplace(key, e, s);
+            if (added) continue;
+            elements_[e].across[s] = it->second.first;
+            elements_[it->second.first].across[it->second.second] = e;
+        }
 }
 
 Eigen::Matrix<double, 3, 2> FemCst::deformationGradient(
@@ -63,6 +82,11 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
 #pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {
         const Element& e = elements_[t];
+        if (!alive_[t]) {
+            cornerForce_[3 * t] = cornerForce_[3 * t + 1] = cornerForce_[3 * t + 2] =
+                Eigen::Vector3d::Zero();
+            continue;
+        }
         const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x);
         const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
         const Eigen::Matrix2d S = lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E;
@@ -100,9 +124,33 @@ std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
     return sums;
 }
 
+std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
+    std::vector<std::array<int, 2>> apart;
+    if (!std::isfinite(criticalStrain_)) return apart;
+    // Largest principal Green strain against the critical stretch's: (l^2 - 1) / 2.
+    const double limit = 0.5 * ((1 + criticalStrain_) * (1 + criticalStrain_) - 1);
+    for (int t = 0; t < int(elements_.size()); ++t) {
+        if (!alive_[t]) continue;
+        const Eigen::Matrix2d E = greenStrain(t, x);
+        const double centre = 0.5 * E.trace();
+        const double radius = std::hypot(0.5 * (E(0, 0) - E(1, 1)), E(0, 1));
+        if (centre + radius <= limit) continue;
+        alive_[t] = 0;
+        triangleAlive_[elements_[t].triangle] = 0;
+        // A side comes apart once no living element holds it.
+        for (int s = 0; s < 3; ++s) {
+            const int other = elements_[t].across[s];
+            if (other >= 0 && alive_[other]) continue;
+            apart.push_back({elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]});
+        }
+    }
+    return apart;
+}
+
 double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     for (int t = 0; t < int(elements_.size()); ++t) {
+        if (!alive_[t]) continue;
         const Eigen::Matrix2d E = greenStrain(t, x);
         sum += elements_[t].restArea * thickness_ *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());

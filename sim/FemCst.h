@@ -21,12 +21,17 @@ namespace rend::sim {
 
 class FemCst final : public Solver {
 public:
-    FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness);
+    /// criticalStrain: an element is removed once its largest principal stretch exceeds
+    /// 1 + criticalStrain (infinity: never).
+    FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness,
+           double criticalStrain);
 
     void forces(const std::vector<Eigen::Vector3d>& x,
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
+    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
 
     /// Green strain of triangle t at positions x, in its rest frame (first axis along edge 01).
     Eigen::Matrix2d greenStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
@@ -37,7 +42,10 @@ private:
         std::array<int, 3> v;
         Eigen::Matrix2d restInverse;  ///< Dm^-1
         double restArea;              ///< A0
+        int triangle;                 ///< index into the lattice's triangles
+        std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
     };
+    void findNeighbours();
     Eigen::Matrix<double, 3, 2> deformationGradient(const Element& e,
                                                     const std::vector<Eigen::Vector3d>& x) const;
 
@@ -46,7 +54,9 @@ private:
     // particle sums its own forces and the loop needs no atomics (and no ordering by thread).
     std::vector<int> cornerOffsets_, corners_;
     mutable std::vector<Eigen::Vector3d> cornerForce_;
-    double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0;
+    double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0, criticalStrain_ = 0.0;
+    std::vector<std::uint8_t> alive_;          ///< per element
+    std::vector<std::uint8_t> triangleAlive_;  ///< per lattice triangle, for the FrameView
 };
 
 /// Per particle, the corners (element * 3 + corner) of the triangles that contain it, in CSR.

@@ -10,8 +10,8 @@
 namespace rend::sim {
 
 MassSpring::MassSpring(const Lattice& lattice, SpringModel model, double youngsModulus,
-                       double poissonRatio, double thickness)
-    : model_(model), poisson_(poissonRatio) {
+                       double poissonRatio, double thickness, double criticalStrain)
+    : model_(model), poisson_(poissonRatio), criticalStrain_(criticalStrain) {
     if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
         throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
     const double E = youngsModulus, t = thickness, nu = poissonRatio;
@@ -57,6 +57,39 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, double youngsM
     }
     tension_.resize(springs_.size());
     triangleTension_.resize(triangles_.size());
+    springAlive_.assign(springs_.size(), 1);
+    triangleIntact_.assign(triangles_.size(), 1);
+    springTriangles_.assign(springs_.size(), {-1, -1});
+    for (int k = 0; k < int(triangles_.size()); ++k)
+        for (int side : triangles_[k].side)
+            springTriangles_[side][springTriangles_[side][0] >= 0] = k;
+}
+
+void MassSpring::breakSpring(int s) {
+    springAlive_[s] = 0;
+    for (int k : springTriangles_[s])
+        if (k >= 0) triangleIntact_[k] = 0;
+}
+
+std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
+    std::vector<std::array<int, 2>> apart;
+    if (!std::isfinite(criticalStrain_)) return apart;
+    for (int s = 0; s < int(springs_.size()); ++s) {
+        const Spring& sp = springs_[s];
+        if (!springAlive_[s] ||
+            (x[sp.j] - x[sp.i]).norm() <= (1.0 + criticalStrain_) * sp.restLength)
+            continue;
+        breakSpring(s);
+        apart.push_back({sp.i, sp.j});
+    }
+    return apart;
+}
+
+bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
+    for (const auto& [a, b] : edges)
+        for (int s = 0; s < int(springs_.size()); ++s)
+            if (std::minmax(a, b) == std::minmax(springs_[s].i, springs_[s].j)) breakSpring(s);
+    return true;
 }
 
 void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
@@ -65,7 +98,8 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
 #pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
         for (int s = 0; s < count; ++s) {
             const Spring& sp = springs_[s];
-            tension_[s] = sp.k * ((x[sp.j] - x[sp.i]).norm() - sp.restLength);
+            tension_[s] =
+                springAlive_[s] ? sp.k * ((x[sp.j] - x[sp.i]).norm() - sp.restLength) : 0.0;
         }
         return;
     }
@@ -75,6 +109,10 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
 #pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
     for (int k = 0; k < triangles; ++k) {
         const Triangle& tri = triangles_[k];
+        if (!triangleIntact_[k]) {
+            triangleTension_[k] = {0.0, 0.0, 0.0};
+            continue;
+        }
         const Eigen::Vector3d& a = x[tri.v[0]];
         const double area = 0.5 * (x[tri.v[1]] - a).cross(x[tri.v[2]] - a).norm();
         std::array<double, 3> q, l0sq;

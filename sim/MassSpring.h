@@ -17,6 +17,7 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "sim/Lattice.h"
@@ -28,13 +29,16 @@ enum class SpringModel { VanGelder, TwoParameter };
 
 class MassSpring final : public Solver {
 public:
+    /// criticalStrain: a spring breaks once stretched past it (infinity: never).
     MassSpring(const Lattice& lattice, SpringModel model, double youngsModulus, double poissonRatio,
-               double thickness);
+               double thickness, double criticalStrain);
 
     void forces(const std::vector<Eigen::Vector3d>& x,
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
+    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    bool cut(const std::vector<std::array<int, 2>>& edges) override;
 
     int springCount() const { return int(springs_.size()); }
     /// Van Gelder's k of spring s (eq. 1) [N/m].
@@ -56,8 +60,15 @@ private:
     /// Tension of every spring [N] at x.
     void tensions(const std::vector<Eigen::Vector3d>& x) const;
 
+    /// A broken spring carries nothing; a two-parameter triangle with a broken side carries
+    /// nothing either (its sides' forces are coupled through its shape).
+    void breakSpring(int s);
+
     SpringModel model_;
     double poisson_;
+    double criticalStrain_;
+    std::vector<std::uint8_t> springAlive_, triangleIntact_;
+    std::vector<std::array<int, 2>> springTriangles_;  ///< the (one or two) triangles of a spring
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;
     // Per particle, its springs (signed: +s+1 when it is end i, -(s+1) when end j), so each

@@ -138,18 +138,28 @@ void Membrane::applySurfaceCorrection() {
         }
 }
 
+double springCriticalStrain(const MembraneParams& params) {
+    const MaterialParams& m = params.material;
+    if (!m.fractureEnergy) return std::numeric_limits<double>::infinity();
+    // The springs crossing a unit length of crack along a hexagonal row (2 / dx of them, each
+    // sqrt(3)/2 E h at nu = 1/3) store G_f h at this strain: k eps^2 dx^2 / 2 * 2 / dx = G_f h.
+    return std::sqrt(2.0 * *m.fractureEnergy /
+                     (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
+}
+
 std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
     const MaterialParams& m = params.material;
     const double h = params.sheet.thickness;
+    const double critical = springCriticalStrain(params);
     switch (params.solver) {
         case SolverKind::FemCst:
-            return std::make_unique<FemCst>(lattice, m.youngsModulus, m.poissonRatio, h);
+            return std::make_unique<FemCst>(lattice, m.youngsModulus, m.poissonRatio, h, critical);
         case SolverKind::MassSpringVanGelder:
             return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m.youngsModulus,
-                                                m.poissonRatio, h);
+                                                m.poissonRatio, h, critical);
         case SolverKind::MassSpringTwoParameter:
             return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m.youngsModulus,
-                                                m.poissonRatio, h);
+                                                m.poissonRatio, h, critical);
         case SolverKind::Peridynamic:
             break;
     }
@@ -162,6 +172,11 @@ void Membrane::useSolver(std::unique_ptr<Solver> solver) {
     double worstRatio = 0.0;
     for (int i = 0; i < particleCount(); ++i) worstRatio = std::max(worstRatio, k[i] / mass_[i]);
     setStableStep(worstRatio);
+}
+
+void Membrane::breakBond(int i, int j) {
+    for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}})
+        if (const int bond = findBond(bonds_, a, b); bond >= 0) bonds_.alive[bond] = 0;
 }
 
 void Membrane::setUpFracture(const MembraneParams& params) {
@@ -178,6 +193,15 @@ void Membrane::setUpFracture(const MembraneParams& params) {
     }
     if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
     notched_ = applyNotches(params.notches, x0_, bonds_);
+    if (solver_ && notched_ > 0) {
+        std::vector<std::array<int, 2>> edges;
+        for (int i = 0; i < particleCount(); ++i)
+            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+                if (!bonds_.alive[b] && i < bonds_.partners[b])
+                    edges.push_back({i, bonds_.partners[b]});
+        if (!solver_->cut(edges))
+            throw std::invalid_argument("this solver cannot represent notches");
+    }
     canDamage_ = m.fractureEnergy.has_value() || !plastic_.empty() || notched_ > 0;
 }
 
@@ -363,9 +387,10 @@ void Membrane::integrate(double dt, double tNext) {
 }
 
 void Membrane::accumulateForces() {
-    if (solver_)
+    if (solver_) {
+        for (const auto& [i, j] : solver_->fracture(x_)) breakBond(i, j);
         solver_->forces(x_, force_);
-    else
+    } else
         bondForces<true>(force_);
     if (!pressureEdgeBonds_.empty()) addPressure(force_);
 }
@@ -547,6 +572,7 @@ FrameView Membrane::view(int frame) const {
     v.bondPartners = bonds_.partners;
     v.bondRestLength = bonds_.restLength;
     v.bondAlive = bonds_.alive;
+    if (solver_) v.triangleAlive = solver_->triangleAlive();
     return v;
 }
 

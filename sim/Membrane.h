@@ -37,6 +37,10 @@ public:
     double suggestedDt;
 };
 
+/// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
+/// lattice row store the fracture energy G_f (infinity without one).
+double springCriticalStrain(const MembraneParams& params);
+
 /// The Solver a scene's `solver` names; nullptr for the built-in peridynamic bonds.
 std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
 
@@ -125,6 +129,8 @@ private:
     void computeBondScales(const MembraneParams& params);
     /// Stable step and runaway-speed limit from max_i k_i / m_i (Solver::stiffnessRowSums).
     void setStableStep(double worstRatio);
+    /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
+    void breakBond(int i, int j);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
     void applySurfaceCorrection();

@@ -9,6 +9,9 @@
 // Membrane. The continuum and spring models of the other papers implement this interface.
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 namespace rend::sim {
@@ -29,6 +32,21 @@ public:
 
     /// Stored elastic energy at positions x [J].
     virtual double strainEnergy(const std::vector<Eigen::Vector3d>& x) const = 0;
+
+    /// Breaks, for good, whatever is past its critical strain at x, and returns the rest
+    /// lattice's edges {i, j} that came apart in this call, so Membrane can break the matching
+    /// bonds (the FrameView, damage and diffusion read those). Nothing breaks by default.
+    virtual std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) {
+        return {};
+    }
+
+    /// Cuts the edges {i, j} at set-up (pre-notches). Returns false when the solver cannot
+    /// represent a cut.
+    virtual bool cut(const std::vector<std::array<int, 2>>& edges) { return edges.empty(); }
+
+    /// Per rest triangle, 1 while it carries load and 0 once removed; empty when the solver
+    /// removes none.
+    virtual std::span<const std::uint8_t> triangleAlive() const { return {}; }
 };
 
 }  // namespace rend::sim

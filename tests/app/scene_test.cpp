@@ -925,10 +925,17 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
               sim::SolverKind::MassSpringTwoParameter);
     const fs::path file = writeScene("minimal.toml", kMinimal);
     EXPECT_NE(errorOf(file, {"solver=fem"}).find("solver: expected one of"), std::string::npos);
-    const std::string fracture = errorOf(file, {"solver=fem_cst", "material.fracture_energy=5"});
-    EXPECT_NE(fracture.find("solver: expected \"peridynamic\" for a scene with fracture"),
+    EXPECT_EQ(loadScene(file, {"solver=fem_cst", "material.fracture_energy=5"})
+                  .sim.material.fractureEnergy,
+              5.0)
+        << "the FEM and spring solvers break by a critical strain";
+    const std::string notch =
+        errorOf(writeScene("notched.toml",
+                           std::string(kMinimal) + "\n[[notch]]\npoints = [[0, 0], [0.1, 0]]\n"),
+                {"solver=fem_cst"});
+    EXPECT_NE(notch.find("solver: expected \"peridynamic\" for a scene with notches"),
               std::string::npos)
-        << fracture;
+        << notch;
     EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
                   .find("a bond law other than linear"),
               std::string::npos);

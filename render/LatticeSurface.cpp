@@ -170,6 +170,7 @@ std::vector<std::uint8_t> LatticeSurface::keptFlags(const sim::FrameView& frame)
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
         bool intact = true;
         for (int e = 0; e < 3; ++e) intact = intact && bondIntact(frame, edgeBonds_[t][e]);
+        if (!frame.triangleAlive.empty()) intact = intact && frame.triangleAlive[t];
         kept[t] = intact ? 1 : 0;
     }
     return kept;

@@ -32,6 +32,9 @@ struct FrameView {
     /// 1 intact, 0 broken. The two copies of a bond (i->j and j->i) always agree: the solver
     /// breaks a bond from both ends, so a reader may look at either.
     std::span<const std::uint8_t> bondAlive;
+    /// Per rest triangle, 0 once the solver removed it (the FEM's element erosion); empty when
+    /// no solver removes triangles. A surface drops a removed triangle like a broken one.
+    std::span<const std::uint8_t> triangleAlive;
 
     std::size_t particleCount() const { return positions.size(); }
 

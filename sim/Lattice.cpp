@@ -1,6 +1,10 @@
 #include "sim/Lattice.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 namespace rend::sim {
 namespace {
@@ -75,6 +79,7 @@ void triangulateCell(Lattice& lattice, const Grid& g, int column, int row, At at
 }  // namespace
 
 Lattice generateLattice(const SheetParams& sheet) {
+    if (sheet.outline == Outline::Sphere) return generateSphere(sheet);
     const Grid g = makeGrid(sheet);
     Lattice lattice;
     lattice.particleArea = sheet.dx * g.rowSpacing;
@@ -97,7 +102,59 @@ Lattice generateLattice(const SheetParams& sheet) {
     return lattice;
 }
 
+namespace {
+
+// The icosahedron's edge is 1.0515 R; each subdivision halves it.
+int sphereSubdivisions(const SheetParams& sheet) {
+    const double edge = 4.0 / std::sqrt(10.0 + 2.0 * std::sqrt(5.0)) * sheet.radius;
+    return std::max(0, int(std::ceil(std::log2(edge / sheet.dx) - 1e-9)));
+}
+
+}  // namespace
+
+Lattice generateSphere(const SheetParams& sheet) {
+    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+    std::vector<Eigen::Vector3d> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                      {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                      {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<std::array<int, 3>> faces = {
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    for (auto& v : p) v.normalize();
+    for (int level = sphereSubdivisions(sheet); level > 0; --level) {
+        std::map<std::pair<int, int>, int> middle;
+        auto midpoint = [&](int a, int b) {
+            const auto [it, added] = middle.try_emplace(std::minmax(a, b), int(p.size()));
+            if (added) p.push_back((p[a] + p[b]).normalized());
+            return it->second;
+        };
+        std::vector<std::array<int, 3>> finer;
+        finer.reserve(4 * faces.size());
+        for (const auto& [a, b, c] : faces) {
+            const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            finer.insert(finer.end(), {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}});
+        }
+        faces = std::move(finer);
+    }
+    Lattice lattice;
+    for (const auto& v : p) lattice.positions.push_back(sheet.center + sheet.radius * v);
+    lattice.triangles = faces;  // counter-clockwise seen from outside
+    lattice.areas.assign(p.size(), 0.0);
+    double total = 0.0;
+    for (const auto& [a, b, c] : faces) {
+        const auto& x = lattice.positions;
+        const double area = 0.5 * (x[b] - x[a]).cross(x[c] - x[a]).norm();
+        for (int v : {a, b, c}) lattice.areas[v] += area / 3.0;
+        total += area;
+    }
+    lattice.particleArea = total / double(p.size());
+    return lattice;
+}
+
 std::size_t estimateParticleCount(const SheetParams& sheet) {
+    if (sheet.outline == Outline::Sphere)
+        return 10 * (std::size_t(1) << (2 * sphereSubdivisions(sheet))) + 2;
     const Grid g = makeGrid(sheet);
     return std::size_t(g.columns) * std::size_t(g.rows);
 }

@@ -6,7 +6,9 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/FemCst.h"
 #include "sim/Fracture.h"
+#include "sim/MassSpring.h"
 
 namespace rend::sim {
 
@@ -18,9 +20,13 @@ Membrane::Membrane(const MembraneParams& params)
     const int n = int(x0_.size());
     if (n < 2) throw std::invalid_argument("the sheet holds fewer than two particles");
     volume_.assign(n, lattice_.particleArea * sheet.thickness);
-    mass_.assign(n, params.material.density * lattice_.particleArea * sheet.thickness);
+    if (!lattice_.areas.empty())
+        for (int i = 0; i < n; ++i) volume_[i] = lattice_.areas[i] * sheet.thickness;
+    mass_.resize(n);
+    for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
     computeBondScales(params);
+    if (params.solver != SolverKind::Peridynamic) useSolver(makeSolver(params, lattice_));
     setUpFracture(params);
     if (params.pressure != 0.0) {
         pressureEdgeBonds_.reserve(lattice_.triangles.size());
@@ -71,15 +77,19 @@ void Membrane::computeBondScales(const MembraneParams& params) {
             stiffness += bondScale_[b] * law_.stiffness() / bonds_.restLength[b];
         worstRatio = std::max(worstRatio, stiffness / mass_[i]);
     }
+    setStableStep(worstRatio);
+}
+
+void Membrane::setStableStep(double worstRatio) {
     stableDt_ = std::sqrt(2.0 / worstRatio);
     // A runaway particle moves far faster than the fastest wave (~dx * omega_max), anything the
     // boundaries impose, or free fall over the whole run.
     double boundarySpeed = 0.0;
-    for (const auto& bc : params.boundaries)
+    for (const auto& bc : params_.boundaries)
         boundarySpeed = std::max(boundarySpeed, bc.velocity.norm());
-    const double waveSpeed = params.sheet.dx * std::sqrt(worstRatio);
+    const double waveSpeed = params_.sheet.dx * std::sqrt(worstRatio);
     speedLimit_ = 100.0 * waveSpeed + 10.0 * boundarySpeed +
-                  2.0 * params.gravity.norm() * params.time.duration + 1e-6;
+                  2.0 * params_.gravity.norm() * params_.time.duration + 1e-6;
 }
 
 namespace {
@@ -128,6 +138,47 @@ void Membrane::applySurfaceCorrection() {
         }
 }
 
+double springCriticalStrain(const MembraneParams& params) {
+    const MaterialParams& m = params.material;
+    if (!m.fractureEnergy) return std::numeric_limits<double>::infinity();
+    // The springs crossing a unit length of crack along a hexagonal row (2 / dx of them, each
+    // sqrt(3)/2 E h at nu = 1/3) store G_f h at this strain: k eps^2 dx^2 / 2 * 2 / dx = G_f h.
+    return std::sqrt(2.0 * *m.fractureEnergy /
+                     (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
+}
+
+std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
+    const MaterialParams& m = params.material;
+    const double h = params.sheet.thickness;
+    const double critical = springCriticalStrain(params);
+    switch (params.solver) {
+        case SolverKind::FemCst:
+            return std::make_unique<FemCst>(lattice, m.youngsModulus, m.poissonRatio, h, critical);
+        case SolverKind::MassSpringVanGelder:
+            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m.youngsModulus,
+                                                m.poissonRatio, h, critical);
+        case SolverKind::MassSpringTwoParameter:
+            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m.youngsModulus,
+                                                m.poissonRatio, h, critical);
+        case SolverKind::Peridynamic:
+            break;
+    }
+    return nullptr;
+}
+
+void Membrane::useSolver(std::unique_ptr<Solver> solver) {
+    solver_ = std::move(solver);
+    const std::vector<double> k = solver_->stiffnessRowSums(particleCount());
+    double worstRatio = 0.0;
+    for (int i = 0; i < particleCount(); ++i) worstRatio = std::max(worstRatio, k[i] / mass_[i]);
+    setStableStep(worstRatio);
+}
+
+void Membrane::breakBond(int i, int j) {
+    for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}})
+        if (const int bond = findBond(bonds_, a, b); bond >= 0) bonds_.alive[bond] = 0;
+}
+
 void Membrane::setUpFracture(const MembraneParams& params) {
     const MaterialParams& m = params.material;
     criticalStretch_ = std::numeric_limits<double>::infinity();
@@ -142,6 +193,15 @@ void Membrane::setUpFracture(const MembraneParams& params) {
     }
     if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
     notched_ = applyNotches(params.notches, x0_, bonds_);
+    if (solver_ && notched_ > 0) {
+        std::vector<std::array<int, 2>> edges;
+        for (int i = 0; i < particleCount(); ++i)
+            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+                if (!bonds_.alive[b] && i < bonds_.partners[b])
+                    edges.push_back({i, bonds_.partners[b]});
+        if (!solver_->cut(edges))
+            throw std::invalid_argument("this solver cannot represent notches");
+    }
     canDamage_ = m.fractureEnergy.has_value() || !plastic_.empty() || notched_ > 0;
 }
 
@@ -255,6 +315,11 @@ void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
 }
 
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
+    if (solver_) {
+        force.resize(x_.size());
+        solver_->forces(x_, force);
+        return;
+    }
     // With kUpdateBonds = false nothing of the membrane is written.
     const_cast<Membrane*>(this)->bondForces<false>(force);
 }
@@ -322,7 +387,11 @@ void Membrane::integrate(double dt, double tNext) {
 }
 
 void Membrane::accumulateForces() {
-    bondForces<true>(force_);
+    if (solver_) {
+        for (const auto& [i, j] : solver_->fracture(x_)) breakBond(i, j);
+        solver_->forces(x_, force_);
+    } else
+        bondForces<true>(force_);
     if (!pressureEdgeBonds_.empty()) addPressure(force_);
 }
 
@@ -436,6 +505,7 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
+    if (solver_) return solver_->strainEnergy(x_);
     const MaterialParams& m = params_.material;
     double sum = 0.0;
     for (int i = 0; i < particleCount(); ++i)
@@ -502,6 +572,7 @@ FrameView Membrane::view(int frame) const {
     v.bondPartners = bonds_.partners;
     v.bondRestLength = bonds_.restLength;
     v.bondAlive = bonds_.alive;
+    if (solver_) v.triangleAlive = solver_->triangleAlive();
     return v;
 }
 

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -21,6 +22,7 @@
 #include "sim/Parallel.h"
 #include "sim/Params.h"
 #include "sim/Random.h"
+#include "sim/Solver.h"
 
 namespace rend::sim {
 
@@ -34,6 +36,13 @@ public:
     int particle;
     double suggestedDt;
 };
+
+/// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
+/// lattice row store the fracture energy G_f (infinity without one).
+double springCriticalStrain(const MembraneParams& params);
+
+/// The Solver a scene's `solver` names; nullptr for the built-in peridynamic bonds.
+std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
 
 class Membrane {
 public:
@@ -118,6 +127,12 @@ private:
     static constexpr std::int16_t kPinned = -2;
 
     void computeBondScales(const MembraneParams& params);
+    /// Stable step and runaway-speed limit from max_i k_i / m_i (Solver::stiffnessRowSums).
+    void setStableStep(double worstRatio);
+    /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
+    void breakBond(int i, int j);
+    /// Hands the internal forces to `solver` and takes its stable step.
+    void useSolver(std::unique_ptr<Solver> solver);
     void applySurfaceCorrection();
     void accumulateForces();  ///< bonds (updating their state) and pressure into force_
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
@@ -162,6 +177,8 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     double speedLimit_ = 0.0;
+    /// The internal forces when the scene's solver is not the built-in peridynamic bonds.
+    std::unique_ptr<Solver> solver_;
     double stiffening_ = 1.0;  ///< power law: df/deta of the most compressed bond over c
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     static constexpr int kMaxPieces = 64;

@@ -12,12 +12,15 @@
 namespace rend::sim {
 
 enum class LatticeKind { Hexagonal, Square };
-enum class Outline { Rectangle, Disc };
+/// Sphere: a closed geodesic sphere (a subdivided icosahedron, edges about dx) of `radius`
+/// around `center`, for inflation tests; its triangles face outwards, so a positive pressure
+/// inflates it.
+enum class Outline { Rectangle, Disc, Sphere };
 
 struct SheetParams {
     Outline outline = Outline::Rectangle;
     Eigen::Vector2d size{2.0, 2.0};   ///< rectangle extent in x and y [m]
-    double radius = 1.0;              ///< disc radius [m]
+    double radius = 1.0;              ///< disc or sphere radius [m]
     Eigen::Vector3d center{0, 0, 0};  ///< the sheet lies in the plane z = center.z at rest
     LatticeKind lattice = LatticeKind::Hexagonal;
     double dx = 0.02;                    ///< particle spacing [m]
@@ -61,8 +64,10 @@ enum class CriticalStretchMode {
 struct MaterialParams {
     std::string name = "custom";
     double youngsModulus = 2e4;  ///< E [Pa]
-    double poissonRatio = 0.3;  ///< used only by the paper's literal constant; bond-based fixes 1/3
-    double density = 5000.0;    ///< rho [kg/m^3]
+    /// nu of the FEM and mass-spring solvers and of the paper's literal constant; the
+    /// peridynamic bonds fix 1/3.
+    double poissonRatio = 0.3;
+    double density = 5000.0;  ///< rho [kg/m^3]
     MicromodulusMode micromodulus = MicromodulusMode::Calibrated;
 
     BondLawKind law = BondLawKind::Linear;
@@ -149,7 +154,13 @@ struct TimeParams {
     bool allowUnstable = false;  ///< expert: accept dt above the bound (the guard still runs)
 };
 
+/// Which discretisation turns positions into internal forces (sim/Solver.h). Peridynamic is the
+/// membrane paper's bond model; the others follow the report (seeds/001) and the mass-spring
+/// paper (seeds/003) on the rest lattice's triangles, with a free Poisson ratio.
+enum class SolverKind { Peridynamic, FemCst, MassSpringVanGelder, MassSpringTwoParameter };
+
 struct MembraneParams {
+    SolverKind solver = SolverKind::Peridynamic;
     SheetParams sheet;
     MaterialParams material;
     std::vector<BoundaryCondition> boundaries;

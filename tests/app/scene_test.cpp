@@ -252,8 +252,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadScene{"bad_unknown_key.toml",
                  "6:2",
-                 {"unknown key 'materal' in the top-level table; expected one of: sheet, material, "
-                  "boundary, notch, diffusion, forces, time, camera, light, render, output. Did "
+                 {"unknown key 'materal' in the top-level table; expected one of: solver, sheet, "
+                  "material, boundary, notch, diffusion, forces, time, camera, light, render, "
+                  "output. Did "
                   "you mean 'material'?"}},
         BadScene{"bad_sub_key.toml",
                  "13:1",
@@ -913,4 +914,29 @@ export = ["glb", "vdb"]
     EXPECT_EQ(s.render.vdb.smoothingIterations, 3);
     EXPECT_DOUBLE_EQ(s.render.vdb.adaptivity, 0.5);
     EXPECT_EQ(s.exports, (std::vector<ExportFormat>{ExportFormat::Glb, ExportFormat::Vdb}));
+}
+
+TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
+    EXPECT_EQ(loadScene(kStretch).sim.solver, sim::SolverKind::Peridynamic) << "the default";
+    EXPECT_EQ(loadScene(kStretch, {"solver=fem_cst"}).sim.solver, sim::SolverKind::FemCst);
+    EXPECT_EQ(loadScene(kStretch, {"solver=mass_spring_vg"}).sim.solver,
+              sim::SolverKind::MassSpringVanGelder);
+    EXPECT_EQ(loadScene(kStretch, {"solver=mass_spring_tp"}).sim.solver,
+              sim::SolverKind::MassSpringTwoParameter);
+    const fs::path file = writeScene("minimal.toml", kMinimal);
+    EXPECT_NE(errorOf(file, {"solver=fem"}).find("solver: expected one of"), std::string::npos);
+    EXPECT_EQ(loadScene(file, {"solver=fem_cst", "material.fracture_energy=5"})
+                  .sim.material.fractureEnergy,
+              5.0)
+        << "the FEM and spring solvers break by a critical strain";
+    const std::string notch =
+        errorOf(writeScene("notched.toml",
+                           std::string(kMinimal) + "\n[[notch]]\npoints = [[0, 0], [0.1, 0]]\n"),
+                {"solver=fem_cst"});
+    EXPECT_NE(notch.find("solver: expected \"peridynamic\" for a scene with notches"),
+              std::string::npos)
+        << notch;
+    EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
+                  .find("a bond law other than linear"),
+              std::string::npos);
 }

@@ -77,6 +77,20 @@ TEST(LatticeSurface, BrokenBoundaryBondDropsItsSingleTriangle) {
     EXPECT_EQ(surface.keptTriangles(sheet.view()).size(), sheet.triangles.size() - 1);
 }
 
+TEST(LatticeSurface, ARemovedTriangleIsDroppedAloneWithItsBondsIntact) {
+    // The FEM solver erodes elements: FrameView::triangleAlive drops exactly those triangles,
+    // the neighbours that share their (intact) edges stay.
+    const GridSheet sheet(6, 5, 1.0);
+    const LatticeSurface surface(sheet.view());
+    std::vector<std::uint8_t> alive(sheet.triangles.size(), 1);
+    alive[7] = 0;
+    rend::sim::FrameView view = sheet.view();
+    view.triangleAlive = alive;
+    const auto kept = surface.keptTriangles(view);
+    EXPECT_EQ(kept.size(), sheet.triangles.size() - 1);
+    EXPECT_EQ(std::count(kept.begin(), kept.end(), 7), 0);
+}
+
 TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {
     GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());

@@ -1,0 +1,181 @@
+#include "sim/MassSpring.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "sim/Parallel.h"
+
+namespace rend::sim {
+
+MassSpring::MassSpring(const Lattice& lattice, SpringModel model, double youngsModulus,
+                       double poissonRatio, double thickness, double criticalStrain)
+    : model_(model), poisson_(poissonRatio), criticalStrain_(criticalStrain) {
+    if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
+        throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
+    const double E = youngsModulus, t = thickness, nu = poissonRatio;
+    const auto& p = lattice.positions;
+    std::map<std::pair<int, int>, int> index;
+    auto springOf = [&](int a, int b) {
+        const auto key = std::minmax(a, b);
+        const auto [it, added] = index.try_emplace(key, int(springs_.size()));
+        if (added) springs_.push_back({key.first, key.second, (p[a] - p[b]).norm(), 0.0});
+        return it->second;
+    };
+    for (const auto& v : lattice.triangles) {
+        Triangle tri{v, {}, {}, 0.0, 0.0};
+        for (int s = 0; s < 3; ++s) {
+            const int a = v[(s + 1) % 3], b = v[(s + 2) % 3];
+            tri.side[s] = springOf(a, b);
+            tri.restLength[s] = (p[a] - p[b]).norm();
+        }
+        tri.restArea = 0.5 * (p[v[1]] - p[v[0]]).cross(p[v[2]] - p[v[0]]).norm();
+        if (tri.restArea <= 0.0) continue;
+        tri.fixedPart = E * t / (8.0 * (1.0 - nu * nu) * tri.restArea);  // eq. 12
+        for (int s = 0; s < 3; ++s) {
+            const double c2 = tri.restLength[s] * tri.restLength[s];
+            const double a2 = std::pow(tri.restLength[(s + 1) % 3], 2);
+            const double b2 = std::pow(tri.restLength[(s + 2) % 3], 2);
+            springs_[tri.side[s]].k +=
+                model == SpringModel::VanGelder
+                    ? E * t / (1.0 + nu) * tri.restArea / c2 +
+                          E * t * nu / (1.0 - nu * nu) * (a2 + b2 - c2) / (8.0 * tri.restArea)
+                    : E * t / (8.0 * (1.0 - nu) * tri.restArea) * (a2 + b2 - c2);  // eq. 16-17
+        }
+        triangles_.push_back(tri);
+    }
+    const int n = int(p.size());
+    springOffsets_.assign(n + 1, 0);
+    for (const Spring& s : springs_) ++springOffsets_[s.i + 1], ++springOffsets_[s.j + 1];
+    for (int i = 0; i < n; ++i) springOffsets_[i + 1] += springOffsets_[i];
+    particleSprings_.resize(springOffsets_.back());
+    std::vector<int> fill(springOffsets_.begin(), springOffsets_.end() - 1);
+    for (int s = 0; s < int(springs_.size()); ++s) {
+        particleSprings_[fill[springs_[s].i]++] = s + 1;
+        particleSprings_[fill[springs_[s].j]++] = -(s + 1);
+    }
+    tension_.resize(springs_.size());
+    triangleTension_.resize(triangles_.size());
+    springAlive_.assign(springs_.size(), 1);
+    triangleIntact_.assign(triangles_.size(), 1);
+    springTriangles_.assign(springs_.size(), {-1, -1});
+    for (int k = 0; k < int(triangles_.size()); ++k)
+        for (int side : triangles_[k].side)
+            springTriangles_[side][springTriangles_[side][0] >= 0] = k;
+}
+
+void MassSpring::breakSpring(int s) {
+    springAlive_[s] = 0;
+    for (int k : springTriangles_[s])
+        if (k >= 0) triangleIntact_[k] = 0;
+}
+
+std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
+    std::vector<std::array<int, 2>> apart;
+    if (!std::isfinite(criticalStrain_)) return apart;
+    for (int s = 0; s < int(springs_.size()); ++s) {
+        const Spring& sp = springs_[s];
+        if (!springAlive_[s] ||
+            (x[sp.j] - x[sp.i]).norm() <= (1.0 + criticalStrain_) * sp.restLength)
+            continue;
+        breakSpring(s);
+        apart.push_back({sp.i, sp.j});
+    }
+    return apart;
+}
+
+bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
+    for (const auto& [a, b] : edges)
+        for (int s = 0; s < int(springs_.size()); ++s)
+            if (std::minmax(a, b) == std::minmax(springs_[s].i, springs_[s].j)) breakSpring(s);
+    return true;
+}
+
+void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
+    const int count = int(springs_.size());
+    if (model_ == SpringModel::VanGelder) {
+#pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
+        for (int s = 0; s < count; ++s) {
+            const Spring& sp = springs_[s];
+            tension_[s] =
+                springAlive_[s] ? sp.k * ((x[sp.j] - x[sp.i]).norm() - sp.restLength) : 0.0;
+        }
+        return;
+    }
+    // Two-parameter: each triangle's share of its three sides' tensions, then the sum per side
+    // in a fixed order (triangle by triangle), so the result does not depend on threads.
+    const int triangles = int(triangles_.size());
+#pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
+    for (int k = 0; k < triangles; ++k) {
+        const Triangle& tri = triangles_[k];
+        if (!triangleIntact_[k]) {
+            triangleTension_[k] = {0.0, 0.0, 0.0};
+            continue;
+        }
+        const Eigen::Vector3d& a = x[tri.v[0]];
+        const double area = 0.5 * (x[tri.v[1]] - a).cross(x[tri.v[2]] - a).norm();
+        std::array<double, 3> q, l0sq;
+        for (int s = 0; s < 3; ++s) {
+            const double l = (x[tri.v[(s + 1) % 3]] - x[tri.v[(s + 2) % 3]]).norm();
+            const double l0 = tri.restLength[s];
+            const double tangent = l / l0 - 1.0;                           // eps_t
+            const double normal = (area / l) / (tri.restArea / l0) - 1.0;  // eps_n: height 2A/l
+            q[s] = normal + poisson_ * tangent;                            // eq. 9
+            l0sq[s] = l0 * l0;
+        }
+        const double all = l0sq[0] * q[0] + l0sq[1] * q[1] + l0sq[2] * q[2];
+        for (int s = 0; s < 3; ++s)  // eqs. 13-14 times eps_b b0
+            triangleTension_[k][s] =
+                tri.fixedPart * tri.restLength[s] * (all - 2.0 * l0sq[s] * q[s]);
+    }
+    std::fill(tension_.begin(), tension_.end(), 0.0);
+    for (int k = 0; k < triangles; ++k)
+        for (int s = 0; s < 3; ++s) tension_[triangles_[k].side[s]] += triangleTension_[k][s];
+}
+
+void MassSpring::forces(const std::vector<Eigen::Vector3d>& x,
+                        std::vector<Eigen::Vector3d>& force) const {
+    tensions(x);
+    const int n = int(x.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int k = springOffsets_[i]; k < springOffsets_[i + 1]; ++k) {
+            const int code = particleSprings_[k];
+            const Spring& sp = springs_[std::abs(code) - 1];
+            const int other = code > 0 ? sp.j : sp.i;
+            const Eigen::Vector3d r = x[other] - x[i];
+            sum += tension_[std::abs(code) - 1] / r.norm() * r;
+        }
+        force[i] = sum;
+    }
+}
+
+std::vector<double> MassSpring::stiffnessRowSums(int particleCount) const {
+    // Van Gelder: sum_j k_ij, as for the peridynamic bonds. The two-parameter force of a side
+    // also depends on the other two sides and the heights; eq. 16's k times (1 + |nu|) bounds
+    // that coupling (checked against a power iteration in the tests).
+    const double coupling =
+        model_ == SpringModel::VanGelder ? 1.0 : 2.0 * (1.0 + std::abs(poisson_));
+    std::vector<double> sums(particleCount, 0.0);
+    for (const Spring& s : springs_) {
+        const double k = coupling * std::abs(s.k);
+        sums[s.i] += k;
+        sums[s.j] += k;
+    }
+    return sums;
+}
+
+double MassSpring::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+    // The two-parameter forces are not the gradient of an energy; report the springs' energy at
+    // their current tensions, 1/2 T (l - l0), which is exact for Van Gelder.
+    tensions(x);
+    double sum = 0.0;
+    for (int s = 0; s < int(springs_.size()); ++s)
+        sum += 0.5 * tension_[s] *
+               ((x[springs_[s].j] - x[springs_[s].i]).norm() - springs_[s].restLength);
+    return sum;
+}
+
+}  // namespace rend::sim

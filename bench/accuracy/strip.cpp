@@ -1,7 +1,7 @@
 // Edge softening against resolution: a strip of fixed width 0.08 m pulled along its length
-// (checks/Strip.h) at dx = W/4 .. W/32 with the same R/dx. The skin's deficit is a fixed number
-// of cells per edge, so E_strip/E - 1 falls as dx / W; the surface correction shrinks the
-// constant.
+// (checks/Strip.h) at dx = W/4 .. W/32 (labels cells=4 .. 32) with the same R/dx. The skin's
+// deficit is a fixed number of cells per edge, so E_strip/E - 1 falls as dx / W; the surface
+// correction shrinks the constant.
 
 #include "tests/validation/checks/Strip.h"
 
@@ -30,7 +30,7 @@ void stripCase(Report& report) {
                     const auto r = timed([&] {
                         const auto start = Clock::now();
                         const double e = checks::stripModulus(s);
-                        return Point{"dx=W/" + std::to_string(cells), secondsSince(start),
+                        return Point{"cells=" + std::to_string(cells), secondsSince(start),
                                      std::abs(e - 1.0)};
                     });
                     f.points.push_back(r);

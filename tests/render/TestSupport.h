@@ -61,7 +61,8 @@ struct Sheet {
                 .bondOffsets = offsets,
                 .bondPartners = partners,
                 .bondRestLength = restLength,
-                .bondAlive = alive};
+                .bondAlive = alive,
+                .triangleAlive = {}};
     }
 
     /// Breaks the bond a-b from both ends. Throws std::out_of_range when a and b are not

@@ -269,9 +269,11 @@ TEST(Solvers, SpringsAlongANotchAreCutAndALoadedNotchedSheetTearsFinitely) {
         }
         std::vector<Eigen::Vector3d> f;
         m.computeForces(f);
-        for (int i = 0; i < m.particleCount(); ++i)
-            if (m.restPositions()[i].x() < -0.05)  // far from the tip, across the cut only
+        for (int i = 0; i < m.particleCount(); ++i) {
+            if (m.restPositions()[i].x() < -0.05) {  // far from the tip, across the cut only
                 EXPECT_LT(f[i].norm(), 1e-12) << nameOf(s) << " particle " << i;
+            }
+        }
 
         BoundaryCondition top, bottom;
         top.kind = bottom.kind = BoundaryKind::Velocity;

@@ -137,8 +137,9 @@ TEST(ValidationSphere, EachSolverMatchesItsClosedFormAndTheTableOfTheMassSpringP
                 row.name, r.particles, r.stretch, row.closedForm, 100 * own, 100 * vsReference,
                 paperVg[c], paperTp[c], r.fiveValent, r.sixValent);
             EXPECT_LT(std::abs(own), 1e-3) << row.name << " case " << c;
-            if (row.solver == SolverKind::MassSpringTwoParameter)
+            if (row.solver == SolverKind::MassSpringTwoParameter) {
                 EXPECT_LE(std::abs(vsReference), std::abs(paperTp[c]) / 100 + 2e-4) << c;
+            }
         }
     }
 }

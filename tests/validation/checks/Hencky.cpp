@@ -11,25 +11,26 @@ using namespace rend::sim;
 
 namespace {
 
-constexpr double kE = 2e4, kH = 1e-3, kRho = 5000;
-
 struct Disc {
     MembraneParams params;
     double clamp;   ///< a_c
     double omega1;  ///< fundamental frequency of the tensioned membrane
 };
 
-Disc discParams(double radius, double dx, double sag) {
+Disc discParams(const DiscSpec& s) {
     Disc d;
-    d.clamp = radius - 2.0 * dx;  // a ring 2 dx > delta = 1.5 dx thick is held
+    d.clamp = s.radius - 2.0 * s.dx;  // a ring 2 dx > delta = 1.5 dx thick is held
+    const double kE = s.youngsModulus, kH = s.thickness, kRho = s.density;
     // Pressure for w0 / a_c = sag in Hencky's formula.
-    const double load = std::pow(sag / kHenckyC, 3) * kE * kH / d.clamp;
+    const double load = s.load > 0 ? s.load : std::pow(s.sag / kHenckyC, 3) * kE * kH / d.clamp;
     MembraneParams& p = d.params;
+    p.solver = s.solver;
     p.sheet.outline = Outline::Disc;
-    p.sheet.radius = radius;
-    p.sheet.dx = dx;
+    p.sheet.radius = s.radius;
+    p.sheet.dx = s.dx;
     p.sheet.thickness = kH;
     p.material.youngsModulus = kE;
+    p.material.poissonRatio = s.poissonRatio;
     p.material.density = kRho;
     p.pressure = load;
     p.gravity = {0, 0, 0};
@@ -97,7 +98,15 @@ double henckyDeflection(double a, double load, double Eh) {
 }
 
 Result clampedDisc(double radius, double dx, double sag) {
-    const Disc d = discParams(radius, dx, sag);
+    DiscSpec spec;
+    spec.radius = radius;
+    spec.dx = dx;
+    spec.sag = sag;
+    return clampedDisc(spec);
+}
+
+Result clampedDisc(const DiscSpec& spec) {
+    const Disc d = discParams(spec);
     Membrane m(d.params);
     const int centre = settle(m, d);
     Result r{};

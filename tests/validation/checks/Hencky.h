@@ -25,6 +25,8 @@
 // of relative order (w0/a)^2 that refinement does not remove: bench/accuracy/hencky.cpp
 // measures it (+0.55% of w0 at w0/a = 0.1).
 
+#include "sim/Params.h"
+
 namespace rend::checks {
 
 constexpr double kHenckyC = 0.6448;  // nu = 1/3
@@ -46,5 +48,15 @@ double henckyDeflection(double a, double load, double Eh);
 /// Hencky's formula says deflects it by w0 = sag * a_c, solved to rest. E = 2e4 Pa, h = 1 mm,
 /// rho = 5000 kg/m^3.
 Result clampedDisc(double radius, double dx, double sag = 0.1);
+
+/// The same set-up for any solver, material and load (the bubble inflation test).
+struct DiscSpec {
+    double radius = 0.5, dx = 0.025;
+    double load = 0.0;  ///< pressure [Pa]; 0: the one for w0 = sag * a_c at nu = 1/3
+    double sag = 0.1;
+    sim::SolverKind solver = sim::SolverKind::Peridynamic;
+    double youngsModulus = 2e4, poissonRatio = 1.0 / 3.0, thickness = 1e-3, density = 5000;
+};
+Result clampedDisc(const DiscSpec& spec);
 
 }  // namespace rend::checks

@@ -798,7 +798,7 @@ void readOutput(const TableReader& root, Scene& scene) {
 void readSolver(const TableReader& root, sim::MembraneParams& p) {
     constexpr Param kSolver{"solver", "the discretisation of the membrane", "\"fem_cst\""};
     static constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
-                                                    "mass_spring_tp"};
+                                                    "mass_spring_tp", "sph"};
     p.solver = sim::SolverKind(root.choice(kSolver, kSolvers).value_or(std::size_t(p.solver)));
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
@@ -806,7 +806,11 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     if (m.law != sim::BondLawKind::Linear) wanted.push_back("a bond law other than linear");
     if (m.criticalStretch == sim::CriticalStretchMode::Paper)
         wanted.push_back("critical_stretch = \"paper\"");
-    if (!p.notches.empty() && p.solver == sim::SolverKind::FemCst) wanted.push_back("notches");
+    const bool sph = p.solver == sim::SolverKind::Sph;
+    if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
+    if (!p.notches.empty() && (sph || p.solver == sim::SolverKind::FemCst))
+        wanted.push_back("notches");
+    if (sph && p.sheet.outline == sim::Outline::Sphere) wanted.push_back("shape = \"sphere\"");
     if (m.expansion != 0.0 || m.stiffnessLoss != 0.0 || m.strengthLoss != 0.0)
         wanted.push_back("diffusion coupling (expansion, stiffness_loss, strength_loss)");
     if (m.surfaceCorrection) wanted.push_back("surface_correction");

@@ -9,6 +9,7 @@
 #include "sim/FemCst.h"
 #include "sim/Fracture.h"
 #include "sim/MassSpring.h"
+#include "sim/TotalLagrangianSph.h"
 
 namespace rend::sim {
 
@@ -160,6 +161,11 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
         case SolverKind::MassSpringTwoParameter:
             return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m.youngsModulus,
                                                 m.poissonRatio, h, critical);
+        case SolverKind::Sph:
+            if (params.sheet.outline == Outline::Sphere)
+                throw std::invalid_argument("the sph solver needs a flat rest sheet");
+            return std::make_unique<TotalLagrangianSph>(lattice, params.sheet.dx, m.youngsModulus,
+                                                        m.poissonRatio, h);
         case SolverKind::Peridynamic:
             break;
     }

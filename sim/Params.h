@@ -156,8 +156,9 @@ struct TimeParams {
 
 /// Which discretisation turns positions into internal forces (sim/Solver.h). Peridynamic is the
 /// membrane paper's bond model; the others follow the report (seeds/001) and the mass-spring
-/// paper (seeds/003) on the rest lattice's triangles, with a free Poisson ratio.
-enum class SolverKind { Peridynamic, FemCst, MassSpringVanGelder, MassSpringTwoParameter };
+/// paper (seeds/003) on the rest lattice's triangles, with a free Poisson ratio; Sph is the
+/// membrane paper's SPH comparison (Sec. 6.1), total-Lagrangian and kernel-corrected.
+enum class SolverKind { Peridynamic, FemCst, MassSpringVanGelder, MassSpringTwoParameter, Sph };
 
 struct MembraneParams {
     SolverKind solver = SolverKind::Peridynamic;

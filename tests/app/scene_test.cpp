@@ -923,6 +923,7 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
               sim::SolverKind::MassSpringVanGelder);
     EXPECT_EQ(loadScene(kStretch, {"solver=mass_spring_tp"}).sim.solver,
               sim::SolverKind::MassSpringTwoParameter);
+    EXPECT_EQ(loadScene(kStretch, {"solver=sph"}).sim.solver, sim::SolverKind::Sph);
     const fs::path file = writeScene("minimal.toml", kMinimal);
     EXPECT_NE(errorOf(file, {"solver=fem"}).find("solver: expected one of"), std::string::npos);
     EXPECT_EQ(loadScene(file, {"solver=fem_cst", "material.fracture_energy=5"})
@@ -936,6 +937,10 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
     EXPECT_NE(notch.find("solver: expected \"peridynamic\" for a scene with notches"),
               std::string::npos)
         << notch;
+    EXPECT_NE(errorOf(file, {"solver=sph", "material.fracture_energy=5"})
+                  .find("for a scene with fracture"),
+              std::string::npos)
+        << "the SPH comparison carries no fracture";
     EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
                   .find("a bond law other than linear"),
               std::string::npos);

@@ -27,15 +27,6 @@ using namespace rend::bench;
 
 namespace {
 
-int nearestParticle(const Membrane& m, const Eigen::Vector2d& at) {
-    int best = 0;
-    for (int i = 1; i < m.particleCount(); ++i)
-        if ((m.restPositions()[i].head<2>() - at).squaredNorm() <
-            (m.restPositions()[best].head<2>() - at).squaredNorm())
-            best = i;
-    return best;
-}
-
 // ---- patch: interior E_eff at strain 1e-4 ---------------------------------------------------
 
 /// In-plane stiffness (Voigt xx, yy, xy) of particle i from the virial stress under three
@@ -80,7 +71,7 @@ PatchResult patchRun(LatticeKind lattice, double factor, double strain) {
     p.sheet.horizonFactor = factor;
     p.material.youngsModulus = E;
     Membrane m(p);
-    const int centre = nearestParticle(m, {0, 0});
+    const int centre = m.nearestParticle({0, 0});
     Eigen::Matrix3d C = voigtStiffness(m, centre, strain);
     // The secant modulus at +strain differs from the tangent by O(strain); averaging with
     // -strain (a central difference) removes that, showing the lattice's own error.
@@ -159,7 +150,7 @@ WaveResult waveRun(const WaveSetup& w) {
         const double s = (m.restPositions()[i].x() - centre) / width;
         m.positions()[i].x() += amplitude * std::exp(-0.5 * s * s);
     }
-    const int near = nearestParticle(m, {-0.1, 0.0}), far = nearestParticle(m, {0.4, 0.0});
+    const int near = m.nearestParticle({-0.1, 0.0}), far = m.nearestParticle({0.4, 0.0});
     std::vector<double> uNear{0.0}, uFar{0.0};  // sample k is at t = k dt
     // The reflection off the left end reaches the near probe at ~0.52 s: stop before it.
     const long steps = long(std::ceil(0.45 / *p.time.dt));

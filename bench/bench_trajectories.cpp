@@ -21,15 +21,6 @@ namespace {
 constexpr const char* kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg", "mass_spring_tp",
                                     "sph"};
 
-int nearestParticle(const rend::sim::Membrane& m, double x, double y) {
-    int best = 0;
-    for (int i = 1; i < m.particleCount(); ++i)
-        if ((m.restPositions()[i].head<2>() - Eigen::Vector2d(x, y)).squaredNorm() <
-            (m.restPositions()[best].head<2>() - Eigen::Vector2d(x, y)).squaredNorm())
-            best = i;
-    return best;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -50,7 +41,7 @@ int main(int argc, char** argv) {
         rend::sim::Membrane m = rend::prepareMembrane(scene);
         const auto [substeps, dt] = rend::substepsPerFrame(m.timeStep(), scene.sim.time.fps);
         m.setTimeStep(dt);
-        const int p1 = nearestParticle(m, -0.36, -0.16), p2 = nearestParticle(m, 0.64, 0.64);
+        const int p1 = m.nearestParticle({-0.36, -0.16}), p2 = m.nearestParticle({0.64, 0.64});
         const auto start = std::chrono::steady_clock::now();
         for (int frame = 0; frame <= scene.frameCount(); ++frame) {
             if (frame > 0)

@@ -221,6 +221,14 @@ void Membrane::assignBoundaries() {
     }
 }
 
+int Membrane::nearestParticle(const Eigen::Vector2d& at) const {
+    int best = 0;
+    for (int i = 1; i < particleCount(); ++i)
+        if ((x0_[i].head<2>() - at).squaredNorm() < (x0_[best].head<2>() - at).squaredNorm())
+            best = i;
+    return best;
+}
+
 std::vector<int> Membrane::boundaryParticleCounts() const {
     std::vector<int> counts(params_.boundaries.size(), 0);
     for (int k = 0; k < int(params_.boundaries.size()); ++k)

@@ -91,6 +91,8 @@ public:
     Eigen::Vector3d totalMomentum() const;
     /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij.
     Eigen::Matrix3d particleStress(int i) const;
+    /// The particle whose rest position (x, y) is nearest to `at` (the lowest index on a tie).
+    int nearestParticle(const Eigen::Vector2d& at) const;
     /// Number of particles each boundary condition claims (a later one wins an overlap).
     std::vector<int> boundaryParticleCounts() const;
 

@@ -25,15 +25,6 @@ MembraneParams smallSheet(LatticeKind lattice, double size = 0.6, double dx = 0.
     return p;
 }
 
-int nearestParticle(const Membrane& m, const Eigen::Vector2d& at) {
-    int best = 0;
-    for (int i = 1; i < m.particleCount(); ++i)
-        if ((m.restPositions()[i].head<2>() - at).norm() <
-            (m.restPositions()[best].head<2>() - at).norm())
-            best = i;
-    return best;
-}
-
 void applyAffine(Membrane& m, const Eigen::Matrix3d& F) {
     for (int i = 0; i < m.particleCount(); ++i) m.positions()[i] = F * m.restPositions()[i];
 }
@@ -78,7 +69,7 @@ TEST(Lattice, InteriorNeighbourCountForHorizonOneAndAHalfSpacings) {
     // sqrt(3) dx) and the 4 + 4 edge and diagonal neighbours of a square one (diagonal sqrt(2) dx).
     for (auto [kind, expected] : {std::pair{LatticeKind::Hexagonal, 6}, {LatticeKind::Square, 8}}) {
         Membrane m(smallSheet(kind));
-        const int centre = nearestParticle(m, {0, 0});
+        const int centre = m.nearestParticle({0, 0});
         EXPECT_EQ(m.bonds().familySize(centre), expected);
     }
 }
@@ -137,7 +128,7 @@ TEST(Bonds, ForceIsTheNegativeGradientOfStrainEnergy) {
                                             0.004 * std::sin(3.0 * i));
     std::vector<Eigen::Vector3d> f;
     m.computeForces(f);
-    const int i = nearestParticle(m, {0, 0});
+    const int i = m.nearestParticle({0, 0});
     const double h = 1e-7;
     for (int axis = 0; axis < 3; ++axis) {
         m.positions()[i][axis] += h;
@@ -167,7 +158,7 @@ TEST(Membrane, MomentumIsConservedWithoutBoundaryConditions) {
 TEST(PatchTest, HexagonalLatticeIsIsotropicWithInputModulusInTheInterior) {
     Membrane m(smallSheet(LatticeKind::Hexagonal));
     const double E = 2e4;
-    const Eigen::Matrix3d C = voigtStiffness(m, nearestParticle(m, {0, 0}), 1e-4);
+    const Eigen::Matrix3d C = voigtStiffness(m, m.nearestParticle({0, 0}), 1e-4);
     for (double phi : {0.0, std::numbers::pi / 4, std::numbers::pi / 6}) {
         const Elastic e = directionalModulus(C, phi);
         std::printf("hexagonal  phi=%5.1f deg  E_eff/E = %.5f  nu = %.4f\n",
@@ -180,7 +171,7 @@ TEST(PatchTest, HexagonalLatticeIsIsotropicWithInputModulusInTheInterior) {
 TEST(PatchTest, SquareLatticeIsAnisotropicSoHexagonalIsTheDefault) {
     Membrane m(smallSheet(LatticeKind::Square));
     const double E = 2e4;
-    const Eigen::Matrix3d C = voigtStiffness(m, nearestParticle(m, {0, 0}), 1e-4);
+    const Eigen::Matrix3d C = voigtStiffness(m, m.nearestParticle({0, 0}), 1e-4);
     const Elastic alongX = directionalModulus(C, 0.0);
     const Elastic diagonal = directionalModulus(C, std::numbers::pi / 4);
     std::printf("square     E_eff/E along x = %.4f (nu %.3f), along diagonal = %.4f (nu %.3f)\n",
@@ -194,7 +185,7 @@ TEST(PatchTest, EdgeSofteningIsReportedAndThePaperConstantIsNotCalibrated) {
     Membrane m(p);
     const double E = 2e4;
     // A particle on the left edge misses half its family: the skin effect of VALIDATION.md.
-    const int edge = nearestParticle(m, {-0.3, 0.0});
+    const int edge = m.nearestParticle({-0.3, 0.0});
     const Elastic atEdge = directionalModulus(voigtStiffness(m, edge, 1e-4), std::numbers::pi / 2);
     std::printf("hexagonal edge particle: E_eff/E along the edge = %.4f\n", atEdge.youngs / E);
     EXPECT_LT(atEdge.youngs / E, 0.95) << "edges are softer than the interior";
@@ -202,7 +193,7 @@ TEST(PatchTest, EdgeSofteningIsReportedAndThePaperConstantIsNotCalibrated) {
     p.material.micromodulus = MicromodulusMode::Paper;
     Membrane paper(p);
     const Elastic literal =
-        directionalModulus(voigtStiffness(paper, nearestParticle(paper, {0, 0}), 1e-4), 0.0);
+        directionalModulus(voigtStiffness(paper, paper.nearestParticle({0, 0}), 1e-4), 0.0);
     std::printf("paper's literal c = 18K/(pi R^4): E_eff/E = %.4g at dx = 0.02, h = 1e-3\n",
                 literal.youngs / E);
     EXPECT_GT(std::abs(literal.youngs / E - 1.0), 0.01);
@@ -291,8 +282,8 @@ TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
     const std::vector<int> counts = m.boundaryParticleCounts();
     EXPECT_GT(counts[0], 0);
     EXPECT_GT(counts[1], 0);
-    const int pulled = nearestParticle(m, {0.2, 0});
-    const int pinned = nearestParticle(m, {-0.2, 0});
+    const int pulled = m.nearestParticle({0.2, 0});
+    const int pinned = m.nearestParticle({-0.2, 0});
     for (int s = 0; s < 50; ++s) m.step();  // halfway up the ramp
     EXPECT_NEAR(m.velocities()[pulled].x(), 0.2 * 0.5, 1e-12);
     for (int s = 0; s < 150; ++s) m.step();

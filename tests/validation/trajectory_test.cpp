@@ -17,15 +17,6 @@ struct Path {
     std::vector<Eigen::Vector2d> p1, p2;
 };
 
-int nearest(const rend::sim::Membrane& m, const Eigen::Vector2d& at) {
-    int best = 0;
-    for (int i = 1; i < m.particleCount(); ++i)
-        if ((m.restPositions()[i].head<2>() - at).norm() <
-            (m.restPositions()[best].head<2>() - at).norm())
-            best = i;
-    return best;
-}
-
 Path run(const char* solver) {
     const rend::Scene scene = rend::loadScene(
         REND_SOURCE_DIR "/scenes/stretch.toml",
@@ -33,7 +24,7 @@ Path run(const char* solver) {
     rend::sim::Membrane m = rend::prepareMembrane(scene);
     const auto [substeps, dt] = rend::substepsPerFrame(m.timeStep(), scene.sim.time.fps);
     m.setTimeStep(dt);
-    const int p1 = nearest(m, {-0.36, -0.16}), p2 = nearest(m, {0.64, 0.64});
+    const int p1 = m.nearestParticle({-0.36, -0.16}), p2 = m.nearestParticle({0.64, 0.64});
     Path path;
     for (int frame = 1; frame <= scene.frameCount(); ++frame) {
         for (int s = 0; s < substeps; ++s) m.step();

@@ -9,12 +9,22 @@
 
 namespace rend::sim {
 
-MassSpring::MassSpring(const Lattice& lattice, SpringModel model, double youngsModulus,
-                       double poissonRatio, double thickness, double criticalStrain)
-    : model_(model), poisson_(poissonRatio), criticalStrain_(criticalStrain) {
-    if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
+MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const MaterialParams& material,
+                       double thickness, double criticalStrain)
+    : model_(model),
+      poisson_(material.poissonRatio),
+      law_(BondLaw::fromMaterial(material, 1.0)),
+      expansion_(material.expansion),
+      stiffnessLoss_(material.stiffnessLoss),
+      strengthLoss_(material.strengthLoss),
+      criticalStrain_(criticalStrain) {
+    if (!(poisson_ > -1.0 && poisson_ < 0.5))
         throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
-    const double E = youngsModulus, t = thickness, nu = poissonRatio;
+    if (model == SpringModel::TwoParameter &&
+        (material.law != BondLawKind::Linear || expansion_ != 0.0 || stiffnessLoss_ != 0.0 ||
+         strengthLoss_ != 0.0))
+        throw std::invalid_argument("the two-parameter springs are linear and uncoupled");
+    const double E = material.youngsModulus, t = thickness, nu = poisson_;
     const auto& p = lattice.positions;
     std::map<std::pair<int, int>, int> index;
     auto springOf = [&](int a, int b) {
@@ -58,6 +68,7 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, double youngsM
     tension_.resize(springs_.size());
     triangleTension_.resize(triangles_.size());
     springAlive_.assign(springs_.size(), 1);
+    if (material.law == BondLawKind::Elastoplastic) plastic_.assign(springs_.size(), {});
     triangleIntact_.assign(triangles_.size(), 1);
     springTriangles_.assign(springs_.size(), {-1, -1});
     for (int k = 0; k < int(triangles_.size()); ++k)
@@ -73,14 +84,14 @@ void MassSpring::breakSpring(int s) {
 
 std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
     std::vector<std::array<int, 2>> apart;
-    if (!std::isfinite(criticalStrain_)) return apart;
     for (int s = 0; s < int(springs_.size()); ++s) {
-        const Spring& sp = springs_[s];
-        if (!springAlive_[s] ||
-            (x[sp.j] - x[sp.i]).norm() <= (1.0 + criticalStrain_) * sp.restLength)
-            continue;
+        if (!springAlive_[s]) continue;
+        double thetaBar;
+        const double eta = mechanicalStrain(s, x, thetaBar);
+        if (!plastic_.empty()) plastic_[s] = law_.yieldStep(eta, plastic_[s]);  // eq. 20
+        if (!(eta > criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar))) continue;
         breakSpring(s);
-        apart.push_back({sp.i, sp.j});
+        apart.push_back({springs_[s].i, springs_[s].j});
     }
     return apart;
 }
@@ -92,14 +103,27 @@ bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
     return true;
 }
 
+double MassSpring::mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x,
+                                    double& thetaBar) const {
+    const Spring& sp = springs_[s];
+    thetaBar = theta_.empty() ? 0.0 : 0.5 * (theta_[sp.i] + theta_[sp.j]);
+    return (x[sp.j] - x[sp.i]).norm() / sp.restLength - 1.0 - expansion_ * thetaBar;
+}
+
 void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
     const int count = int(springs_.size());
     if (model_ == SpringModel::VanGelder) {
 #pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
         for (int s = 0; s < count; ++s) {
-            const Spring& sp = springs_[s];
-            tension_[s] =
-                springAlive_[s] ? sp.k * ((x[sp.j] - x[sp.i]).norm() - sp.restLength) : 0.0;
+            if (!springAlive_[s]) {
+                tension_[s] = 0.0;
+                continue;
+            }
+            double thetaBar;
+            const double eta = mechanicalStrain(s, x, thetaBar);
+            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[s];
+            tension_[s] = springs_[s].k * springs_[s].restLength * law_.force(eta, state) *
+                          std::max(0.0, 1.0 - stiffnessLoss_ * thetaBar);
         }
         return;
     }
@@ -168,10 +192,21 @@ std::vector<double> MassSpring::stiffnessRowSums(int particleCount) const {
 }
 
 double MassSpring::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
-    // The two-parameter forces are not the gradient of an energy; report the springs' energy at
-    // their current tensions, 1/2 T (l - l0), which is exact for Van Gelder.
-    tensions(x);
     double sum = 0.0;
+    if (model_ == SpringModel::VanGelder) {  // k L0^2 Psi(eta), Psi the law's energy at c = 1
+        for (int s = 0; s < int(springs_.size()); ++s) {
+            if (!springAlive_[s]) continue;
+            double thetaBar;
+            const double eta = mechanicalStrain(s, x, thetaBar);
+            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[s];
+            sum += springs_[s].k * springs_[s].restLength * springs_[s].restLength *
+                   law_.energy(eta, state) * std::max(0.0, 1.0 - stiffnessLoss_ * thetaBar);
+        }
+        return sum;
+    }
+    // The two-parameter forces are not the gradient of an energy; report the springs' energy at
+    // their current tensions, 1/2 T (l - l0).
+    tensions(x);
     for (int s = 0; s < int(springs_.size()); ++s)
         sum += 0.5 * tension_[s] *
                ((x[springs_[s].j] - x[springs_[s].i]).norm() - springs_[s].restLength);

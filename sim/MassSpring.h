@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/BondLaw.h"
 #include "sim/Lattice.h"
 #include "sim/Solver.h"
 
@@ -29,8 +30,10 @@ enum class SpringModel { VanGelder, TwoParameter };
 
 class MassSpring final : public Solver {
 public:
-    /// criticalStrain: a spring breaks once stretched past it (infinity: never).
-    MassSpring(const Lattice& lattice, SpringModel model, double youngsModulus, double poissonRatio,
+    /// criticalStrain: a spring breaks once stretched past it (infinity: never). Van Gelder's
+    /// springs also take the material's bond law (its shape, scaled to slope k at rest), its
+    /// thermal strain alpha theta_bar and its stiffness and strength losses, as the bonds do.
+    MassSpring(const Lattice& lattice, SpringModel model, const MaterialParams& material,
                double thickness, double criticalStrain);
 
     void forces(const std::vector<Eigen::Vector3d>& x,
@@ -64,8 +67,14 @@ private:
     /// nothing either (its sides' forces are coupled through its shape).
     void breakSpring(int s);
 
+    /// Mechanical strain of spring s at x (thermal strain removed) and its theta_bar.
+    double mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x, double& thetaBar) const;
+
     SpringModel model_;
     double poisson_;
+    BondLaw law_;  ///< the material's law with c = 1: tension = k L0 f(eta)
+    double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
+    std::vector<PlasticState> plastic_;  ///< per spring; empty unless elastoplastic
     double criticalStrain_;
     std::vector<std::uint8_t> springAlive_, triangleIntact_;
     std::vector<std::array<int, 2>> springTriangles_;  ///< the (one or two) triangles of a spring

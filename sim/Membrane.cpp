@@ -156,11 +156,9 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
         case SolverKind::FemCst:
             return std::make_unique<FemCst>(lattice, m.youngsModulus, m.poissonRatio, h, critical);
         case SolverKind::MassSpringVanGelder:
-            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m.youngsModulus,
-                                                m.poissonRatio, h, critical);
+            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
         case SolverKind::MassSpringTwoParameter:
-            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m.youngsModulus,
-                                                m.poissonRatio, h, critical);
+            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h, critical);
         case SolverKind::Sph:
             if (params.sheet.outline == Outline::Sphere)
                 throw std::invalid_argument("the sph solver needs a flat rest sheet");
@@ -331,6 +329,7 @@ void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
     if (solver_) {
         force.resize(x_.size());
+        solver_->setTheta(theta_);
         solver_->forces(x_, force);
         return;
     }
@@ -402,6 +401,7 @@ void Membrane::integrate(double dt, double tNext) {
 
 void Membrane::accumulateForces() {
     if (solver_) {
+        solver_->setTheta(theta_);
         for (const auto& [i, j] : solver_->fracture(x_)) breakBond(i, j);
         solver_->forces(x_, force_);
     } else
@@ -519,7 +519,10 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
-    if (solver_) return solver_->strainEnergy(x_);
+    if (solver_) {
+        solver_->setTheta(theta_);
+        return solver_->strainEnergy(x_);
+    }
     const MaterialParams& m = params_.material;
     double sum = 0.0;
     for (int i = 0; i < particleCount(); ++i)

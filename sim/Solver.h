@@ -47,6 +47,13 @@ public:
     /// Per rest triangle, 1 while it carries load and 0 once removed; empty when the solver
     /// removes none.
     virtual std::span<const std::uint8_t> triangleAlive() const { return {}; }
+
+    /// The diffusing quantity per particle (empty without diffusion), for the solvers that
+    /// couple to it; Membrane sets it before every forces() and fracture().
+    void setTheta(std::span<const double> theta) { theta_ = theta; }
+
+protected:
+    std::span<const double> theta_;
 };
 
 }  // namespace rend::sim

@@ -941,6 +941,9 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
                   .find("for a scene with fracture"),
               std::string::npos)
         << "the SPH comparison carries no fracture";
+    EXPECT_EQ(loadScene(file, {"solver=mass_spring_vg", "material.law=power_law"}).sim.material.law,
+              sim::BondLawKind::PowerLaw)
+        << "Van Gelder's springs take the bond laws";
     EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
                   .find("a bond law other than linear"),
               std::string::npos);

@@ -300,3 +300,32 @@ TEST(Solvers, SpringsAlongANotchAreCutAndALoadedNotchedSheetTearsFinitely) {
         for (const auto& x : loaded.positions()) ASSERT_TRUE(x.allFinite()) << nameOf(s);
     }
 }
+
+TEST(Solvers, VanGelderSpringsTakeTheThermalStrainAndTheBondLaws) {
+    // Uniform theta = 1 with alpha = 0.01: the free sheet settles 1% larger, exactly.
+    MembraneParams p = sheet(SolverKind::MassSpringVanGelder, 1.0 / 3.0, 0.2, 0.2);
+    p.material.expansion = 0.01;
+    p.diffusion.initial = 1.0;
+    p.damping = 20.0;
+    Membrane warm(p);
+    for (int k = 0; k < 4000; ++k) warm.step();
+    const int a = warm.nearestParticle({-0.1, 0}), b = warm.nearestParticle({0.1, 0});
+    const double strain = (warm.positions()[b] - warm.positions()[a]).norm() /
+                              (warm.restPositions()[b] - warm.restPositions()[a]).norm() -
+                          1.0;
+    EXPECT_NEAR(strain, 0.01, 1e-6) << "free thermal expansion";
+
+    // Elastoplastic springs keep a permanent set once loaded past the yield strain (eq. 20).
+    p = sheet(SolverKind::MassSpringVanGelder, 1.0 / 3.0, 0.2, 0.2);
+    p.material.law = BondLawKind::Elastoplastic;
+    p.material.yieldStrain = 0.01;
+    p.material.softening = 0.5;
+    Membrane m(p);
+    for (int i = 0; i < m.particleCount(); ++i) m.positions()[i] = 1.03 * m.restPositions()[i];
+    m.step();  // records the largest strain of every spring
+    for (int i = 0; i < m.particleCount(); ++i) m.positions()[i] = m.restPositions()[i];
+    std::vector<Eigen::Vector3d> f;
+    m.computeForces(f);
+    EXPECT_GT(maxNorm(f), 0.0) << "at the rest shape the yielded springs push: a permanent set";
+    EXPECT_GT(m.strainEnergy(), 0.0);
+}

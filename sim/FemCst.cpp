@@ -1,5 +1,6 @@
 #include "sim/FemCst.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -21,13 +22,17 @@ void triangleIncidence(const std::vector<std::array<int, 3>>& triangles, int par
         for (int c = 0; c < 3; ++c) corners[fill[triangles[t][c]]++] = 3 * t + c;
 }
 
-FemCst::FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness,
+FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double thickness,
                double criticalStrain)
-    : thickness_(thickness), criticalStrain_(criticalStrain) {
-    if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
-        throw std::invalid_argument("fem_cst needs -1 < poisson < 0.5");
-    lambda_ = youngsModulus * poissonRatio / (1.0 - poissonRatio * poissonRatio);
-    mu_ = youngsModulus / (2.0 * (1.0 + poissonRatio));
+    : thickness_(thickness),
+      criticalStrain_(criticalStrain),
+      expansion_(material.expansion),
+      stiffnessLoss_(material.stiffnessLoss),
+      strengthLoss_(material.strengthLoss) {
+    const double nu = material.poissonRatio;
+    if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("fem_cst needs -1 < poisson < 0.5");
+    lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
+    mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
     const auto& p = lattice.positions;
     for (int index = 0; index < int(lattice.triangles.size()); ++index) {
         const auto& t = lattice.triangles[index];
@@ -87,11 +92,16 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
                 Eigen::Vector3d::Zero();
             continue;
         }
-        const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x);
+        // The thermal strain stretches the rest state isotropically by s = 1 + alpha theta:
+        // Psi(F / s), whose derivative is P(F / s) / s.
+        const double theta = thetaOf(e), stretch = 1.0 + expansion_ * theta;
+        const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x) / stretch;
         const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
-        const Eigen::Matrix2d S = lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E;
+        const Eigen::Matrix2d S =
+            std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
+            (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
         const Eigen::Matrix<double, 3, 2> H =
-            -e.restArea * thickness_ * F * S * e.restInverse.transpose();
+            -e.restArea * thickness_ / stretch * F * S * e.restInverse.transpose();
         cornerForce_[3 * t + 1] = H.col(0);
         cornerForce_[3 * t + 2] = H.col(1);
         cornerForce_[3 * t] = -H.col(0) - H.col(1);
@@ -124,35 +134,61 @@ std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
     return sums;
 }
 
+double FemCst::thetaOf(const Element& e) const {
+    if (theta_.empty()) return 0.0;
+    return (theta_[e.v[0]] + theta_[e.v[1]] + theta_[e.v[2]]) / 3.0;
+}
+
+void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
+    alive_[t] = 0;
+    triangleAlive_[elements_[t].triangle] = 0;
+    for (int s = 0; s < 3; ++s) {  // a side comes apart once no living element holds it
+        const int other = elements_[t].across[s];
+        if (other >= 0 && alive_[other]) continue;
+        apart.push_back({elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]});
+    }
+}
+
 std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
     std::vector<std::array<int, 2>> apart;
     if (!std::isfinite(criticalStrain_)) return apart;
-    // Largest principal Green strain against the critical stretch's: (l^2 - 1) / 2.
-    const double limit = 0.5 * ((1 + criticalStrain_) * (1 + criticalStrain_) - 1);
     for (int t = 0; t < int(elements_.size()); ++t) {
         if (!alive_[t]) continue;
-        const Eigen::Matrix2d E = greenStrain(t, x);
+        // Largest principal Green strain of the mechanical part against the critical
+        // stretch's, (l^2 - 1) / 2, with l = 1 + eps_c weakened by theta.
+        const double theta = thetaOf(elements_[t]);
+        const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * theta);
+        const double stretch = 1.0 + expansion_ * theta;
+        const Eigen::Matrix2d E =
+            0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
+                   Eigen::Matrix2d::Identity());
         const double centre = 0.5 * E.trace();
         const double radius = std::hypot(0.5 * (E(0, 0) - E(1, 1)), E(0, 1));
-        if (centre + radius <= limit) continue;
-        alive_[t] = 0;
-        triangleAlive_[elements_[t].triangle] = 0;
-        // A side comes apart once no living element holds it.
-        for (int s = 0; s < 3; ++s) {
-            const int other = elements_[t].across[s];
-            if (other >= 0 && alive_[other]) continue;
-            apart.push_back({elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]});
-        }
+        if (centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1)) erode(t, apart);
     }
     return apart;
+}
+
+bool FemCst::cut(const std::vector<std::array<int, 2>>& edges) {
+    std::map<std::pair<int, int>, bool> isCut;
+    for (const auto& [a, b] : edges) isCut[std::minmax(a, b)] = true;
+    std::vector<std::array<int, 2>> unused;
+    for (int t = 0; t < int(elements_.size()); ++t)
+        for (int s = 0; s < 3 && alive_[t]; ++s)
+            if (isCut.count(std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3])))
+                erode(t, unused);
+    return true;
 }
 
 double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     for (int t = 0; t < int(elements_.size()); ++t) {
         if (!alive_[t]) continue;
-        const Eigen::Matrix2d E = greenStrain(t, x);
-        sum += elements_[t].restArea * thickness_ *
+        const double theta = thetaOf(elements_[t]), stretch = 1.0 + expansion_ * theta;
+        const Eigen::Matrix2d E =
+            0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
+                   Eigen::Matrix2d::Identity());
+        sum += elements_[t].restArea * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }
     return sum;

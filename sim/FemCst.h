@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sim/Lattice.h"
+#include "sim/Params.h"
 #include "sim/Solver.h"
 
 namespace rend::sim {
@@ -23,7 +24,9 @@ class FemCst final : public Solver {
 public:
     /// criticalStrain: an element is removed once its largest principal stretch exceeds
     /// 1 + criticalStrain (infinity: never).
-    FemCst(const Lattice& lattice, double youngsModulus, double poissonRatio, double thickness,
+    /// The material's thermal strain alpha theta and its stiffness and strength losses apply
+    /// per element, with theta averaged over its corners.
+    FemCst(const Lattice& lattice, const MaterialParams& material, double thickness,
            double criticalStrain);
 
     void forces(const std::vector<Eigen::Vector3d>& x,
@@ -31,6 +34,8 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
     std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    /// A notch removes every element with a cut side (a gap one element wide).
+    bool cut(const std::vector<std::array<int, 2>>& edges) override;
     std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
 
     /// Green strain of triangle t at positions x, in its rest frame (first axis along edge 01).
@@ -46,6 +51,10 @@ private:
         std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
     };
     void findNeighbours();
+    /// Mean theta over the element's corners (0 without diffusion).
+    double thetaOf(const Element& e) const;
+    /// Removes element t and returns the sides no living element holds any more.
+    void erode(int t, std::vector<std::array<int, 2>>& apart);
     Eigen::Matrix<double, 3, 2> deformationGradient(const Element& e,
                                                     const std::vector<Eigen::Vector3d>& x) const;
 
@@ -55,6 +64,7 @@ private:
     std::vector<int> cornerOffsets_, corners_;
     mutable std::vector<Eigen::Vector3d> cornerForce_;
     double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0, criticalStrain_ = 0.0;
+    double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
     std::vector<std::uint8_t> alive_;          ///< per element
     std::vector<std::uint8_t> triangleAlive_;  ///< per lattice triangle, for the FrameView
 };

@@ -20,10 +20,8 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
       criticalStrain_(criticalStrain) {
     if (!(poisson_ > -1.0 && poisson_ < 0.5))
         throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
-    if (model == SpringModel::TwoParameter &&
-        (material.law != BondLawKind::Linear || expansion_ != 0.0 || stiffnessLoss_ != 0.0 ||
-         strengthLoss_ != 0.0))
-        throw std::invalid_argument("the two-parameter springs are linear and uncoupled");
+    if (model == SpringModel::TwoParameter && material.law != BondLawKind::Linear)
+        throw std::invalid_argument("the two-parameter springs are linear");
     const double E = material.youngsModulus, t = thickness, nu = poisson_;
     const auto& p = lattice.positions;
     std::map<std::pair<int, int>, int> index;
@@ -139,19 +137,25 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
         }
         const Eigen::Vector3d& a = x[tri.v[0]];
         const double area = 0.5 * (x[tri.v[1]] - a).cross(x[tri.v[2]] - a).norm();
+        // The thermal strain scales the triangle's rest shape by s = 1 + alpha theta_bar: rest
+        // lengths and heights by s, so the forces (b0 Q a0^2 ~ s) by s too.
+        double theta = 0.0;
+        if (!theta_.empty()) theta = (theta_[tri.v[0]] + theta_[tri.v[1]] + theta_[tri.v[2]]) / 3;
+        const double stretch = 1.0 + expansion_ * theta;
         std::array<double, 3> q, l0sq;
         for (int s = 0; s < 3; ++s) {
             const double l = (x[tri.v[(s + 1) % 3]] - x[tri.v[(s + 2) % 3]]).norm();
             const double l0 = tri.restLength[s];
-            const double tangent = l / l0 - 1.0;                           // eps_t
-            const double normal = (area / l) / (tri.restArea / l0) - 1.0;  // eps_n: height 2A/l
-            q[s] = normal + poisson_ * tangent;                            // eq. 9
+            const double tangent = l / (l0 * stretch) - 1.0;                         // eps_t
+            const double normal = (area / l) / (tri.restArea / l0 * stretch) - 1.0;  // eps_n
+            q[s] = normal + poisson_ * tangent;                                      // eq. 9
             l0sq[s] = l0 * l0;
         }
         const double all = l0sq[0] * q[0] + l0sq[1] * q[1] + l0sq[2] * q[2];
+        const double scale = stretch * std::max(0.0, 1.0 - stiffnessLoss_ * theta);
         for (int s = 0; s < 3; ++s)  // eqs. 13-14 times eps_b b0
             triangleTension_[k][s] =
-                tri.fixedPart * tri.restLength[s] * (all - 2.0 * l0sq[s] * q[s]);
+                scale * tri.fixedPart * tri.restLength[s] * (all - 2.0 * l0sq[s] * q[s]);
     }
     std::fill(tension_.begin(), tension_.end(), 0.0);
     for (int k = 0; k < triangles; ++k)

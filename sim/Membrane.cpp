@@ -154,7 +154,7 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
     const double critical = springCriticalStrain(params);
     switch (params.solver) {
         case SolverKind::FemCst:
-            return std::make_unique<FemCst>(lattice, m.youngsModulus, m.poissonRatio, h, critical);
+            return std::make_unique<FemCst>(lattice, m, h, critical);
         case SolverKind::MassSpringVanGelder:
             return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
         case SolverKind::MassSpringTwoParameter:

@@ -933,7 +933,7 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
     const std::string notch =
         errorOf(writeScene("notched.toml",
                            std::string(kMinimal) + "\n[[notch]]\npoints = [[0, 0], [0.1, 0]]\n"),
-                {"solver=fem_cst"});
+                {"solver=sph"});
     EXPECT_NE(notch.find("solver: expected \"peridynamic\" for a scene with notches"),
               std::string::npos)
         << notch;

@@ -2,11 +2,14 @@
 // lattice, boundaries and integrators as the peridynamic membrane.
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numbers>
+#include <utility>
 
 #include "sim/FemCst.h"
 #include "sim/MassSpring.h"
@@ -363,5 +366,37 @@ TEST(Solvers, AFemNotchRemovesTheElementsItCuts) {
         if (m.restPositions()[i].x() < -0.05) {  // far from the tip, across the cut only
             EXPECT_LT(f[i].norm(), 1e-12) << i;
         }
+    }
+}
+
+TEST(Solvers, OneAndTwoThreadsGiveIdenticalBitsWithEverySolver) {
+    // Each solver computes per element (or particle) in parallel and sums per particle in a
+    // fixed order, so the thread count cannot change a bit, fracture included.
+    for (SolverKind s : kSolvers) {
+        MembraneParams p = sheet(s, 0.3, 1.0, 1.0);
+        p.sheet.perturbationAmplitude = 1e-4;
+        if (s != SolverKind::Sph) p.material.fractureEnergy = 0.02;
+        BoundaryCondition left, right;
+        left.kind = right.kind = BoundaryKind::Velocity;
+        left.region.max.x() = -0.49;
+        right.region.min.x() = 0.49;
+        left.velocity = {-0.3, 0, 0.02};
+        right.velocity = {0.3, 0, 0};
+        p.boundaries = {left, right};
+        auto run = [&](int threads) {
+            omp_set_num_threads(threads);
+            Membrane m(p);
+            EXPECT_GT(m.particleCount(), kParallelThreshold) << "must take the parallel path";
+            for (int k = 0; k < 300; ++k) m.step();
+            return std::pair{m.positions(), m.brokenBondCount()};
+        };
+        const auto [one, brokenOne] = run(1);
+        const auto [two, brokenTwo] = run(2);
+        omp_set_num_threads(2);
+        ASSERT_EQ(one.size(), two.size());
+        EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(one[0])), 0) << nameOf(s);
+        EXPECT_EQ(brokenOne, brokenTwo) << nameOf(s);
+        std::printf("%-15s 1 and 2 threads: identical bits, %zu broken bonds\n", nameOf(s),
+                    brokenOne);
     }
 }

@@ -792,10 +792,10 @@ void readOutput(const TableReader& root, Scene& scene) {
     }
 }
 
-// `solver = "..."` at the top level. The FEM and mass-spring solvers break by a critical strain
-// from fracture_energy and couple to theta; only Van Gelder's springs also take the bond laws,
-// and the SPH comparison takes none of these: a scene asking for what its solver lacks is
-// refused, not silently run without.
+// `solver = "..."` at the top level. Every solver takes notches and couples to theta; all but the
+// SPH break by a critical strain from fracture_energy; only Van Gelder's springs take the bond
+// laws, and the SPH needs a flat sheet: a scene asking for what its solver lacks is refused,
+// not silently run without.
 void readSolver(const TableReader& root, sim::MembraneParams& p) {
     constexpr Param kSolver{"solver", "the discretisation of the membrane", "\"fem_cst\""};
     static constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
@@ -804,19 +804,18 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
-    // Van Gelder's springs take the bond laws; every solver but the SPH comparison takes
-    // fracture, notches and the coupling to theta.
+    // Van Gelder's springs take the bond laws; every solver takes notches and the coupling to
+    // theta, and all but the SPH fracture.
     const bool vanGelder = p.solver == sim::SolverKind::MassSpringVanGelder;
     const bool sph = p.solver == sim::SolverKind::Sph;
+    if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
     if (m.law != sim::BondLawKind::Linear && !vanGelder)
         wanted.push_back("a bond law other than linear");
     if (m.criticalStretch == sim::CriticalStretchMode::Paper)
         wanted.push_back("critical_stretch = \"paper\"");
-    if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
-    if (!p.notches.empty() && sph) wanted.push_back("notches");
+
     if (sph && p.sheet.outline == sim::Outline::Sphere) wanted.push_back("shape = \"sphere\"");
-    if ((m.expansion != 0.0 || m.stiffnessLoss != 0.0 || m.strengthLoss != 0.0) && sph)
-        wanted.push_back("diffusion coupling (expansion, stiffness_loss, strength_loss)");
+
     if (m.surfaceCorrection) wanted.push_back("surface_correction");
     std::string needs;
     for (std::size_t k = 0; k < wanted.size(); ++k)

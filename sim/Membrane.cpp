@@ -162,8 +162,8 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
         case SolverKind::Sph:
             if (params.sheet.outline == Outline::Sphere)
                 throw std::invalid_argument("the sph solver needs a flat rest sheet");
-            return std::make_unique<TotalLagrangianSph>(lattice, params.sheet.dx, m.youngsModulus,
-                                                        m.poissonRatio, h);
+            return std::make_unique<TotalLagrangianSph>(lattice, params.sheet.dx, m, h,
+                                                        params.notches);
         case SolverKind::Peridynamic:
             break;
     }

@@ -1,10 +1,11 @@
 #include "sim/TotalLagrangianSph.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "sim/Bonds.h"
+#include "sim/Fracture.h"
 #include "sim/Parallel.h"
 
 namespace rend::sim {
@@ -20,41 +21,50 @@ double kernel(double r, double support) {
 
 }  // namespace
 
-TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx, double youngsModulus,
-                                       double poissonRatio, double thickness)
-    : thickness_(thickness) {
-    if (!(poissonRatio > -1.0 && poissonRatio < 0.5))
-        throw std::invalid_argument("sph needs -1 < poisson < 0.5");
-    lambda_ = youngsModulus * poissonRatio / (1.0 - poissonRatio * poissonRatio);
-    mu_ = youngsModulus / (2.0 * (1.0 + poissonRatio));
-    const auto& X = lattice.positions;
-    const int n = int(X.size());
-    const double support = kSupport * dx;
-    const BondFamilies family = buildBondFamilies(X, support);
-    offsets_ = family.offsets;
-    neighbours_ = family.partners;
+TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
+                                       const MaterialParams& material, double thickness,
+                                       std::span<const Notch> notches)
+    : rest_(lattice.positions),
+      support_(kSupport * dx),
+      expansion_(material.expansion),
+      stiffnessLoss_(material.stiffnessLoss),
+      strengthLoss_(material.strengthLoss),
+      thickness_(thickness) {
+    const double nu = material.poissonRatio;
+    if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("sph needs -1 < poisson < 0.5");
+    lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
+    mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
+    const int n = int(rest_.size());
+    pairs_ = buildBondFamilies(rest_, support_);
+    applyNotches(notches, rest_, pairs_);
+    offsets_ = pairs_.offsets;
+    neighbours_ = pairs_.partners;
     volume_.assign(n, lattice.particleArea);
     if (!lattice.areas.empty()) volume_ = lattice.areas;
     gradient_.resize(neighbours_.size());
-    for (int i = 0; i < n; ++i) {
-        Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
-            const int j = neighbours_[k];
-            const Eigen::Vector2d d = (X[j] - X[i]).head<2>();
-            gradient_[k] = volume_[j] * kernel(d.norm(), support) * d;
-            A += d * gradient_[k].transpose();
-        }
-        if (std::abs(A.determinant()) < 1e-12 * std::pow(A.norm(), 2))
-            throw std::invalid_argument("sph: a particle's neighbours do not span the plane");
-        const Eigen::Matrix2d correction = A.inverse().transpose();
-        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
-            gradient_[k] = correction * gradient_[k];
-    }
+    for (int i = 0; i < n; ++i) correctGradients(i);
     mirror_.resize(neighbours_.size());
     for (int i = 0; i < n; ++i)
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
-            mirror_[k] = findBond(family, neighbours_[k], i);
+            mirror_[k] = findBond(pairs_, neighbours_[k], i);
     stress_.resize(n);
+}
+
+void TotalLagrangianSph::correctGradients(int i) {
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
+        const Eigen::Vector2d d = (rest_[neighbours_[k]] - rest_[i]).head<2>();
+        gradient_[k] =
+            pairs_.alive[k]
+                ? Eigen::Vector2d(volume_[neighbours_[k]] * kernel(d.norm(), support_) * d)
+                : Eigen::Vector2d::Zero();
+        A += d * gradient_[k].transpose();
+    }
+    const double size = A.norm();
+    const bool spans = size > 0.0 && std::abs(A.determinant()) > 1e-6 * size * size;
+    Eigen::Matrix2d correction = Eigen::Matrix2d::Zero();
+    if (spans) correction = A.inverse().transpose();
+    for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) gradient_[k] = correction * gradient_[k];
 }
 
 Eigen::Matrix<double, 3, 2> TotalLagrangianSph::deformationGradient(
@@ -75,8 +85,12 @@ void TotalLagrangianSph::forces(const std::vector<Eigen::Vector3d>& x,
                                 std::vector<Eigen::Vector3d>& force) const {
     const int n = int(x.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i)
-        stress_[i] = volume_[i] * thickness_ * firstPiola(deformationGradient(i, x));
+    for (int i = 0; i < n; ++i) {
+        // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
+        const double stretch = 1.0 + expansion_ * thetaAt(i);
+        stress_[i] = volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) /
+                     stretch * firstPiola(deformationGradient(i, x) / stretch);
+    }
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector2d own = Eigen::Vector2d::Zero();
@@ -113,9 +127,10 @@ std::vector<double> TotalLagrangianSph::stiffnessRowSums(int particleCount) cons
 double TotalLagrangianSph::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     for (int i = 0; i < int(x.size()); ++i) {
-        const Eigen::Matrix<double, 3, 2> F = deformationGradient(i, x);
+        const Eigen::Matrix<double, 3, 2> F =
+            deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(i));
         const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
-        sum += volume_[i] * thickness_ *
+        sum += volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }
     return sum;

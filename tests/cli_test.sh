@@ -84,14 +84,14 @@ check "only frames 5-6 written" test "$(ls "$tmp/range/frames" | tr '\n' ' ')" =
 check "renderer none" run 0 run scenes/stretch.toml "${small[@]}" --renderer none --out "$tmp/none"
 check "renderer none writes no frames" test ! -e "$tmp/none/frames"
 
-# Solvers: any scene runs with another discretisation; one that asks for what the solver lacks is
-# refused before anything is written.
+# Solvers: any scene runs with another discretisation; one that asks for what the solver lacks
+# (here a curved rest shape for the SPH) is refused before anything is written.
 check "fem solver runs" run 0 run scenes/stretch.toml "${small[@]}" --set solver=fem_cst \
     --renderer none --out "$tmp/fem"
 check "fem run.json ok" grep -q '"status": "ok"' "$tmp/fem/run.json"
-check "sph refuses a notch" run 2 run scenes/crack_path.toml --set solver=sph --out "$tmp/sphnotch"
+check "sph refuses a sphere" run 2 run scenes/pressurised_sphere.toml --set solver=sph --out "$tmp/sphsphere"
 check "sph refusal names the solver" grep -q "solver: expected \"peridynamic\"" "$tmp/stderr"
-check "sph refusal leaves no output" test ! -e "$tmp/sphnotch"
+check "sph refusal leaves no output" test ! -e "$tmp/sphsphere"
 
 # Skipping: --renderer none with no export builds no surface, and the simulation is bitwise the
 # same with and without rendering and exports (run.json's state_hash covers x, v, theta, bonds).

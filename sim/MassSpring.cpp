@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "sim/Parallel.h"
@@ -95,9 +96,10 @@ std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Ve
 }
 
 bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
-    for (const auto& [a, b] : edges)
-        for (int s = 0; s < int(springs_.size()); ++s)
-            if (std::minmax(a, b) == std::minmax(springs_[s].i, springs_[s].j)) breakSpring(s);
+    std::set<std::pair<int, int>> cuts;  // springs are stored with i < j
+    for (const auto& [a, b] : edges) cuts.insert(std::minmax(a, b));
+    for (int s = 0; s < int(springs_.size()); ++s)
+        if (cuts.count({springs_[s].i, springs_[s].j})) breakSpring(s);
     return true;
 }
 

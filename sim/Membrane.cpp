@@ -402,8 +402,8 @@ void Membrane::integrate(double dt, double tNext) {
 void Membrane::accumulateForces() {
     if (solver_) {
         solver_->setTheta(theta_);
-        for (const auto& [i, j] : solver_->fracture(x_)) breakBond(i, j);
-        solver_->forces(x_, force_);
+        for (const auto& [i, j] : solver_->advance(x_, v_, dt_, force_)) breakBond(i, j);
+        stiffening_ = solver_->stiffening();
     } else
         bondForces<true>(force_);
     if (!pressureEdgeBonds_.empty()) addPressure(force_);
@@ -504,9 +504,11 @@ void Membrane::updateDamage() {
         double total = 0.0, intact = 0.0;
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             total += bonds_.weight[b];
-            if (bonds_.alive[b])
-                intact += bonds_.weight[b] *
-                          (plastic_.empty() ? 1.0 : law_.strengthLeft(plastic_[b]));  // eq. 27
+            if (!bonds_.alive[b]) continue;
+            const double left = solver_            ? solver_->bondStrengthLeft(b)
+                                : plastic_.empty() ? 1.0
+                                                   : law_.strengthLeft(plastic_[b]);  // eq. 27
+            intact += bonds_.weight[b] * left;
         }
         damage_[i] = total > 0.0 ? 1.0 - intact / total : 0.0;
     }

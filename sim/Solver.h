@@ -4,9 +4,8 @@
 // conditions, gravity, damping, the follower pressure, the integrators with their stable step,
 // the blow-up guard, diffusion and the FrameView. A Solver only turns positions into forces.
 //
-// The peridynamic bonds (the membrane paper's model) are Membrane's built-in solver: its force
-// loop is compiled per bond law and fused with fracture and diffusion coupling, so it stays in
-// Membrane. The continuum and spring models of the other papers implement this interface.
+// Implemented by the peridynamic bonds of the membrane paper (PeridynamicBonds) and by the
+// continuum, spring and SPH models of the other papers.
 
 #include <Eigen/Core>
 #include <array>
@@ -39,6 +38,27 @@ public:
     virtual std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) {
         return {};
     }
+
+    /// One step's forces at x that also move the solver's history on: whatever is past its
+    /// critical strain breaks, whatever yields yields. Returns the rest edges that came apart, as
+    /// fracture() does. `v` and `dt` let a law that stiffens (the power law in compression) look
+    /// ahead for stiffening(). By default fracture() then forces().
+    virtual std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
+                                                    const std::vector<Eigen::Vector3d>& v,
+                                                    double dt,
+                                                    std::vector<Eigen::Vector3d>& force) {
+        std::vector<std::array<int, 2>> apart = fracture(x);
+        forces(x, force);
+        return apart;
+    }
+
+    /// The worst tangent stiffness over its rest value (>= 1) seen by the last advance(): the
+    /// explicit step is cut into pieces so each stays within the rest bound over its square root.
+    virtual double stiffening() const { return 1.0; }
+
+    /// Fraction of strength (eq. 27's gamma) the shared bond b of the Membrane's BondFamilies
+    /// still has, for the damage field; 1 unless the solver keeps it per bond.
+    virtual double bondStrengthLeft(int bond) const { return 1.0; }
 
     /// Cuts the edges {i, j} at set-up (pre-notches). Returns false when the solver cannot
     /// represent a cut.

@@ -9,6 +9,7 @@
 #include "sim/FemCst.h"
 #include "sim/Fracture.h"
 #include "sim/MassSpring.h"
+#include "sim/PeridynamicBonds.h"
 #include "sim/TotalLagrangianSph.h"
 
 namespace rend::sim {
@@ -26,9 +27,11 @@ Membrane::Membrane(const MembraneParams& params)
     mass_.resize(n);
     for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
-    computeBondScales(params);
-    if (params.solver != SolverKind::Peridynamic) useSolver(makeSolver(params, lattice_));
-    setUpFracture(params);
+    if (params.solver == SolverKind::Peridynamic)
+        useSolver(std::make_unique<PeridynamicBonds>(params, lattice_, bonds_, x0_, volume_));
+    else
+        useSolver(makeSolver(params, lattice_));
+    setUpNotches(params);
     if (params.pressure != 0.0) {
         pressureEdgeBonds_.reserve(lattice_.triangles.size());
         for (const auto& t : lattice_.triangles)
@@ -49,38 +52,6 @@ Membrane::Membrane(const MembraneParams& params)
     updateDamage();
 }
 
-void Membrane::computeBondScales(const MembraneParams& params) {
-    const int n = particleCount();
-    const bool paper = params.material.micromodulus == MicromodulusMode::Paper;
-    bondScale_.resize(bonds_.directedCount());
-    for (int i = 0; i < n; ++i)
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-            const int j = bonds_.partners[b];
-            // Literal eq. 22 multiplies by the area A_j; the consistent form by V_i V_j.
-            const double measure = paper ? lattice_.particleArea : volume_[i] * volume_[j];
-            bondScale_[b] = bonds_.weight[b] * measure / bonds_.restLength[b];
-        }
-    const double interiorWeightedVolume = interiorFamilySum(
-        bonds_, [&](int b) { return bonds_.weight[b] * volume_[bonds_.partners[b]]; });
-    if (interiorWeightedVolume <= 0.0)
-        throw std::invalid_argument(
-            "no particle has a bond with non-zero weight: raise the horizon");
-    if (params.material.surfaceCorrection) applySurfaceCorrection();
-    const MaterialParams& m = params.material;
-    const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
-                           : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
-    law_ = BondLaw::fromMaterial(m, c);
-
-    double worstRatio = 0.0;  // max_i sum_j k_ij / m_i
-    for (int i = 0; i < n; ++i) {
-        double stiffness = 0.0;
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-            stiffness += bondScale_[b] * law_.stiffness() / bonds_.restLength[b];
-        worstRatio = std::max(worstRatio, stiffness / mass_[i]);
-    }
-    setStableStep(worstRatio);
-}
-
 void Membrane::setStableStep(double worstRatio) {
     stableDt_ = std::sqrt(2.0 / worstRatio);
     // A runaway particle moves far faster than the fastest wave (~dx * omega_max), anything the
@@ -91,52 +62,6 @@ void Membrane::setStableStep(double worstRatio) {
     const double waveSpeed = params_.sheet.dx * std::sqrt(worstRatio);
     speedLimit_ = 100.0 * waveSpeed + 10.0 * boundarySpeed +
                   2.0 * params_.gravity.norm() * params_.time.duration + 1e-6;
-}
-
-namespace {
-
-// Strain energy density of particle i under unit uniaxial stress along axis a, up to a constant
-// common to all particles: sum_j W0 V_j |xi| s^2 (the linear law's micropotential c s^2 |xi| / 2),
-// with the bond stretch s = n.eps.n of the plane-stress strain eps = a a - (1/3) a' a' (nu = 1/3)
-// and W0 V_j |xi| written through the bond scale W0 V_i V_j / |xi| of equal particle volumes.
-double uniaxialStressEnergy(const BondFamilies& bonds, const std::vector<double>& bondScale,
-                            const std::vector<Eigen::Vector3d>& x0, int i, int a) {
-    double sum = 0.0;
-    for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
-        const Eigen::Vector3d n = (x0[bonds.partners[b]] - x0[i]) / bonds.restLength[b];
-        const double along = n[a] * n[a];
-        const double s = along - (1.0 - along) / 3.0;
-        sum += bondScale[b] * bonds.restLength[b] * bonds.restLength[b] * s * s;
-    }
-    return sum;
-}
-
-}  // namespace
-
-void Membrane::applySurfaceCorrection() {
-    const int n = particleCount();
-    // Energy method (Madenci & Oterkus 2014, Sec. 4.2) with uniaxial stress, not strain, as the
-    // loading: an edge is free of stress across it, so that is the state its particles meet.
-    std::vector<Eigen::Vector2d> factor(n, Eigen::Vector2d::Ones());
-    for (int a = 0; a < 2; ++a) {
-        std::vector<double> energy(n);
-        double interior = 0.0;
-        for (int i = 0; i < n; ++i) {
-            energy[i] = uniaxialStressEnergy(bonds_, bondScale_, x0_, i, a);
-            interior = std::max(interior, energy[i]);
-        }
-        for (int i = 0; i < n; ++i)
-            if (energy[i] > 0.0) factor[i][a] = interior / energy[i];
-    }
-    // The ends' mean keeps the bond symmetric (equal and opposite forces); the ellipse through
-    // the x and y factors gives the factor along the bond's direction n.
-    for (int i = 0; i < n; ++i)
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-            const int j = bonds_.partners[b];
-            const Eigen::Vector3d d = (x0_[j] - x0_[i]) / bonds_.restLength[b];
-            const Eigen::Vector2d g = 0.5 * (factor[i] + factor[j]);
-            bondScale_[b] /= std::hypot(d.x() / g.x(), d.y() / g.y());
-        }
 }
 
 double springCriticalStrain(const MembraneParams& params) {
@@ -183,21 +108,20 @@ void Membrane::breakBond(int i, int j) {
         if (const int bond = findBond(bonds_, a, b); bond >= 0) bonds_.alive[bond] = 0;
 }
 
-void Membrane::setUpFracture(const MembraneParams& params) {
+const PeridynamicBonds& Membrane::peridynamicBonds() const {
+    const auto* bonds = dynamic_cast<const PeridynamicBonds*>(solver_.get());
+    if (!bonds) throw std::logic_error("only the peridynamic solver has bond constants");
+    return *bonds;
+}
+
+const BondLaw& Membrane::law() const { return peridynamicBonds().law(); }
+
+double Membrane::criticalStretch() const { return peridynamicBonds().criticalStretch(); }
+
+void Membrane::setUpNotches(const MembraneParams& params) {
     const MaterialParams& m = params.material;
-    criticalStretch_ = std::numeric_limits<double>::infinity();
-    if (m.fractureEnergy) {
-        const double interiorMoment = interiorFamilySum(bonds_, [&](int b) {  // sum_j W0 |xi| V_j
-            return bonds_.weight[b] * bonds_.restLength[b] * volume_[bonds_.partners[b]];
-        });
-        criticalStretch_ =
-            m.criticalStretch == CriticalStretchMode::Paper
-                ? paperCriticalStretch(*m.fractureEnergy, m.youngsModulus, horizon_)
-                : calibratedCriticalStretch(*m.fractureEnergy, law_.c, interiorMoment);
-    }
-    if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
     notched_ = applyNotches(params.notches, x0_, bonds_);
-    if (solver_ && notched_ > 0) {
+    if (notched_ > 0) {
         std::vector<std::array<int, 2>> edges;
         for (int i = 0; i < particleCount(); ++i)
             for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
@@ -206,7 +130,8 @@ void Membrane::setUpFracture(const MembraneParams& params) {
         if (!solver_->cut(edges))
             throw std::invalid_argument("this solver cannot represent notches");
     }
-    canDamage_ = m.fractureEnergy.has_value() || !plastic_.empty() || notched_ > 0;
+    canDamage_ =
+        m.fractureEnergy.has_value() || m.law == BondLawKind::Elastoplastic || notched_ > 0;
 }
 
 void Membrane::assignBoundaries() {
@@ -241,100 +166,10 @@ void Membrane::perturb(double amplitude, std::uint64_t seed) {
         x_[i].z() += amplitude * (2.0 * uniformFromHash(seed, std::uint64_t(i)) - 1.0);
 }
 
-double Membrane::mechanicalStrain(int i, int b, double length, double& thetaBar) const {
-    const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
-    if (theta_.empty()) {
-        thetaBar = 0.0;
-        return eta;
-    }
-    // The printed eqs. 18-20 use theta_j alone; the mean is symmetric, so the pair forces stay
-    // equal and opposite and momentum is conserved.
-    thetaBar = 0.5 * (theta_[i] + theta_[bonds_.partners[b]]);
-    return eta - params_.material.expansion * thetaBar;
-}
-
-// Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
-// Both copies of a bond see the same strain bit for bit, so they break and yield together.
-template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
-void Membrane::bondForcesFor(std::vector<Eigen::Vector3d>& force) {
-    const int n = particleCount();
-    force.resize(n);
-    const auto& offsets = bonds_.offsets;
-    const MaterialParams& m = params_.material;
-    double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
-#pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        const Eigen::Vector3d xi = x_[i];
-        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
-            if (!bonds_.alive[b]) continue;
-            const int j = bonds_.partners[b];
-            const Eigen::Vector3d r = x_[j] - xi;
-            const double length = r.norm();
-            double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
-            double thetaBar = 0.0;
-            if constexpr (kTheta) {  // see mechanicalStrain()
-                thetaBar = 0.5 * (theta_[i] + theta_[j]);
-                eta -= m.expansion * thetaBar;
-            }
-            if constexpr (kBreak) {  // eq. 27/28
-                double limit = criticalStretch_;
-                if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
-                if (eta > limit) {
-                    if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
-                    continue;
-                }
-            }
-            PlasticState state;
-            if constexpr (kLaw == BondLawKind::Elastoplastic) {
-                state = law_.yieldStep(eta, plastic_[b]);
-                if constexpr (kUpdateBonds) plastic_[b] = state;
-            }
-            if constexpr (kLaw == BondLawKind::PowerLaw) {
-                if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
-                    const double rate = r.dot(v_[j] - v_[i]) / (length * bonds_.restLength[b]);
-                    lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
-                }
-            }
-            double f = law_.forceAs<kLaw>(eta, state);
-            if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
-            sum += (bondScale_[b] * f / length) * r;
-        }
-        force[i] = sum;
-    }
-    if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw)
-        stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
-}
-
-template <bool kUpdateBonds>
-void Membrane::bondForces(std::vector<Eigen::Vector3d>& force) {
-    const bool theta = !theta_.empty();
-    const bool breakable = std::isfinite(criticalStretch_);
-    auto forLaw = [&]<BondLawKind kLaw>() {
-        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(force);
-        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(force);
-        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(force);
-        if (!theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, false, false>(force);
-    };
-    switch (law_.kind) {
-        case BondLawKind::Linear:
-            return forLaw.template operator()<BondLawKind::Linear>();
-        case BondLawKind::PowerLaw:
-            return forLaw.template operator()<BondLawKind::PowerLaw>();
-        case BondLawKind::Elastoplastic:
-            return forLaw.template operator()<BondLawKind::Elastoplastic>();
-    }
-}
-
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
-    if (solver_) {
-        force.resize(x_.size());
-        solver_->setTheta(theta_);
-        solver_->forces(x_, force);
-        return;
-    }
-    // With kUpdateBonds = false nothing of the membrane is written.
-    const_cast<Membrane*>(this)->bondForces<false>(force);
+    force.resize(x_.size());
+    solver_->setTheta(theta_);
+    solver_->forces(x_, force);
 }
 
 Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
@@ -400,12 +235,9 @@ void Membrane::integrate(double dt, double tNext) {
 }
 
 void Membrane::accumulateForces() {
-    if (solver_) {
-        solver_->setTheta(theta_);
-        for (const auto& [i, j] : solver_->advance(x_, v_, dt_, force_)) breakBond(i, j);
-        stiffening_ = solver_->stiffening();
-    } else
-        bondForces<true>(force_);
+    solver_->setTheta(theta_);
+    for (const auto& [i, j] : solver_->advance(x_, v_, dt_, force_)) breakBond(i, j);
+    stiffening_ = solver_->stiffening();
     if (!pressureEdgeBonds_.empty()) addPressure(force_);
 }
 
@@ -505,10 +337,7 @@ void Membrane::updateDamage() {
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             total += bonds_.weight[b];
             if (!bonds_.alive[b]) continue;
-            const double left = solver_            ? solver_->bondStrengthLeft(b)
-                                : plastic_.empty() ? 1.0
-                                                   : law_.strengthLeft(plastic_[b]);  // eq. 27
-            intact += bonds_.weight[b] * left;
+            intact += bonds_.weight[b] * solver_->bondStrengthLeft(b);
         }
         damage_[i] = total > 0.0 ? 1.0 - intact / total : 0.0;
     }
@@ -521,24 +350,8 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
-    if (solver_) {
-        solver_->setTheta(theta_);
-        return solver_->strainEnergy(x_);
-    }
-    const MaterialParams& m = params_.material;
-    double sum = 0.0;
-    for (int i = 0; i < particleCount(); ++i)
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-            if (!bonds_.alive[b]) continue;
-            double thetaBar;
-            const double length = (x_[bonds_.partners[b]] - x_[i]).norm();
-            const double eta = mechanicalStrain(i, b, length, thetaBar);
-            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
-            // Each bond is stored from both ends: half of U_ij from each.
-            sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
-                   degradation(m.stiffnessLoss, thetaBar) * law_.energy(eta, state);
-        }
-    return sum;
+    solver_->setTheta(theta_);
+    return solver_->strainEnergy(x_);
 }
 
 double Membrane::maxSpeed() const {
@@ -562,19 +375,8 @@ Eigen::Vector3d Membrane::totalMomentum() const {
 }
 
 Eigen::Matrix3d Membrane::particleStress(int i) const {
-    const MaterialParams& m = params_.material;
-    Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
-    for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-        if (!bonds_.alive[b]) continue;
-        const Eigen::Vector3d r = x_[bonds_.partners[b]] - x_[i];
-        const double length = r.norm();
-        double thetaBar;
-        const double eta = mechanicalStrain(i, b, length, thetaBar);
-        const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
-        const double f = degradation(m.stiffnessLoss, thetaBar) * law_.force(eta, state);
-        sigma += (bondScale_[b] * f / length) * r * r.transpose();
-    }
-    return sigma / (2.0 * volume_[i]);
+    solver_->setTheta(theta_);
+    return peridynamicBonds().particleStress(i, x_);
 }
 
 FrameView Membrane::view(int frame) const {
@@ -591,11 +393,8 @@ FrameView Membrane::view(int frame) const {
     v.bondPartners = bonds_.partners;
     v.bondRestLength = bonds_.restLength;
     v.bondAlive = bonds_.alive;
-    if (solver_) v.triangleAlive = solver_->triangleAlive();
+    v.triangleAlive = solver_->triangleAlive();
     return v;
 }
-
-template void Membrane::bondForces<true>(std::vector<Eigen::Vector3d>&);
-template void Membrane::bondForces<false>(std::vector<Eigen::Vector3d>&);
 
 }  // namespace rend::sim

@@ -1,9 +1,9 @@
 #pragma once
-// The peridynamic membrane of the membrane paper (seeds/000_68a9cbaeb8170387.txt, Sections
-// 4-5): one layer of particles joined by micro-springs within the cutoff R (three bond laws,
-// eqs. 18-20), broken for good past the critical stretch (eqs. 27-28), with a diffusive
-// quantity theta (eq. 25) that strains and weakens the bonds, advanced with the explicit
-// symplectic Euler scheme of eq. 26 (velocity first, then position).
+// The membrane of the membrane paper (seeds/000_68a9cbaeb8170387.txt, Sections 4-5): one layer
+// of particles with the bonds within the cutoff R, a diffusive quantity theta (eq. 25) moving
+// along them, advanced with the explicit symplectic Euler scheme of eq. 26 (velocity first,
+// then position) or velocity Verlet. The internal forces come from the scene's Solver: the
+// paper's micro-spring bonds (PeridynamicBonds) or one of the other papers' discretisations.
 
 #include <Eigen/Core>
 #include <array>
@@ -41,7 +41,10 @@ public:
 /// lattice row store the fracture energy G_f (infinity without one).
 double springCriticalStrain(const MembraneParams& params);
 
-/// The Solver a scene's `solver` names; nullptr for the built-in peridynamic bonds.
+class PeridynamicBonds;
+
+/// The Solver a scene's `solver` names, for the solvers that do not use the Membrane's bonds
+/// (the peridynamic one does; the Membrane builds it).
 std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
 
 class Membrane {
@@ -51,10 +54,12 @@ public:
     int particleCount() const { return int(x0_.size()); }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }
-    double micromodulus() const { return law_.c; }
-    const BondLaw& law() const { return law_; }
+    // The peridynamic bonds' constants; these throw std::logic_error for another solver.
+    double micromodulus() const { return law().c; }
+    const BondLaw& law() const;
     /// eta_c at theta = 0; +infinity when the material has no fracture energy.
-    double criticalStretch() const { return criticalStretch_; }
+    double criticalStretch() const;
+    const Solver& solver() const { return *solver_; }
     bool hasDiffusion() const { return diffusion_.has_value(); }
     const Diffusion* diffusion() const { return diffusion_ ? &*diffusion_ : nullptr; }
     std::size_t notchedBondCount() const { return notched_; }
@@ -75,8 +80,8 @@ public:
     /// NumericalBlowUp naming the step and the first offending particle.
     void step();
 
-    /// Internal bond forces on every particle (eq. 22 with the current bond direction), without
-    /// changing any bond's state.
+    /// The solver's internal forces on every particle (for the bonds, eq. 22 with the current
+    /// bond direction), without changing any state.
     void computeForces(std::vector<Eigen::Vector3d>& force) const;
 
     /// Recomputes the per-particle damage field: 1 - sum of intact weighted bond strength /
@@ -89,7 +94,8 @@ public:
     double maxTheta() const;  ///< 0 without diffusion
     std::size_t brokenBondCount() const;
     Eigen::Vector3d totalMomentum() const;
-    /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij.
+    /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij (peridynamic
+    /// bonds only).
     Eigen::Matrix3d particleStress(int i) const;
     /// The particle whose rest position (x, y) is nearest to `at` (the lowest index on a tie).
     int nearestParticle(const Eigen::Vector2d& at) const;
@@ -128,33 +134,22 @@ private:
     static constexpr std::int16_t kFree = -1;
     static constexpr std::int16_t kPinned = -2;
 
-    void computeBondScales(const MembraneParams& params);
     /// Stable step and runaway-speed limit from max_i k_i / m_i (Solver::stiffnessRowSums).
     void setStableStep(double worstRatio);
     /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
     void breakBond(int i, int j);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
-    void applySurfaceCorrection();
-    void accumulateForces();  ///< bonds (updating their state) and pressure into force_
+    const PeridynamicBonds& peridynamicBonds() const;
+    void accumulateForces();  ///< the solver's (updating its state) and pressure into force_
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
     void stepSymplecticEuler();
     void stepVelocityVerlet();
     /// v += h * acceleration for free particles; prescribed velocities for the others.
     void kick(double h, double tNext);
     void checkFinite();
-    void setUpFracture(const MembraneParams& params);
-    template <bool kUpdateBonds>
-    void bondForces(std::vector<Eigen::Vector3d>& force);
-    /// The force loop compiled for one law and for whether theta exists and bonds can break,
-    /// so a stage a scene does not need costs nothing per bond.
-    template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
-    void bondForcesFor(std::vector<Eigen::Vector3d>& force);
-    /// Mechanical strain of bond b of particle i (diffusion strain removed) and its theta_bar.
-    double mechanicalStrain(int i, int b, double length, double& thetaBar) const;
-    double degradation(double loss, double thetaBar) const {
-        return std::max(0.0, 1.0 - loss * thetaBar);
-    }
+    /// Notches: breaks the bonds they cross and has the solver cut the same edges.
+    void setUpNotches(const MembraneParams& params);
     void assignBoundaries();
     void perturb(double amplitude, std::uint64_t seed);
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
@@ -168,8 +163,6 @@ private:
     MembraneParams params_;
     Lattice lattice_;
     BondFamilies bonds_;
-    BondLaw law_;
-    double criticalStretch_ = 0.0;
     bool canDamage_ = false;
     std::size_t notched_ = 0;
     std::optional<Diffusion> diffusion_;
@@ -179,18 +172,15 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     double speedLimit_ = 0.0;
-    /// The internal forces when the scene's solver is not the built-in peridynamic bonds.
-    std::unique_ptr<Solver> solver_;
-    double stiffening_ = 1.0;  ///< power law: df/deta of the most compressed bond over c
-    long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
+    std::unique_ptr<Solver> solver_;  ///< the internal forces
+    double stiffening_ = 1.0;         ///< the solver's worst tangent stiffness over its rest one
+    long subSteps_ = 0;               ///< extra pieces the power law's stiffening asked for
     static constexpr int kMaxPieces = 64;
 
     // Structure of arrays: one contiguous array per attribute.
     std::vector<Eigen::Vector3d> x_, v_, x0_, force_;
     std::vector<double> mass_, volume_;
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
-    std::vector<double> bondScale_;         ///< force on i per unit of f(eta), see BondLaw.h
-    std::vector<PlasticState> plastic_;     ///< per bond; empty unless the law is elastoplastic
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
     std::vector<std::array<int, 3>> pressureEdgeBonds_;  ///< per rest triangle; empty if p = 0

@@ -1,5 +1,5 @@
-// The solvers of sim/Solver.h (FEM CST, Van Gelder and two-parameter mass-spring) on the same
-// lattice, boundaries and integrators as the peridynamic membrane.
+// The solvers of sim/Solver.h (peridynamic bonds, FEM CST, Van Gelder and two-parameter
+// mass-spring, SPH) on the same lattice, boundaries and integrators.
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -14,13 +14,15 @@
 #include "sim/FemCst.h"
 #include "sim/MassSpring.h"
 #include "sim/Membrane.h"
+#include "sim/PeridynamicBonds.h"
 #include "sim/Random.h"
 
 using namespace rend::sim;
 
 namespace {
 
-constexpr SolverKind kSolvers[] = {SolverKind::FemCst, SolverKind::MassSpringVanGelder,
+constexpr SolverKind kSolvers[] = {SolverKind::Peridynamic, SolverKind::FemCst,
+                                   SolverKind::MassSpringVanGelder,
                                    SolverKind::MassSpringTwoParameter, SolverKind::Sph};
 
 const char* nameOf(SolverKind s) {
@@ -90,9 +92,25 @@ TEST(Solvers, RigidMotionGivesZeroForce) {
     }
 }
 
-TEST(Solvers, FemAndSphForcesAreMinusTheGradientOfTheStrainEnergy) {
-    for (SolverKind s : {SolverKind::FemCst, SolverKind::Sph}) {
-        Membrane m(sheet(s, 0.3, 0.12, 0.12));
+TEST(Solvers, BondFemAndSphForcesAreMinusTheGradientOfTheStrainEnergy) {
+    struct Case {
+        SolverKind solver;
+        BondLawKind law;
+    };
+    const Case cases[] = {{SolverKind::Peridynamic, BondLawKind::Linear},
+                          {SolverKind::Peridynamic, BondLawKind::PowerLaw},
+                          {SolverKind::Peridynamic, BondLawKind::Elastoplastic},
+                          {SolverKind::FemCst, BondLawKind::Linear},
+                          {SolverKind::Sph, BondLawKind::Linear}};
+    for (const auto& [s, law] : cases) {
+        MembraneParams p = sheet(s, 0.3, 0.12, 0.12);
+        p.material.law = law;
+        p.material.powerLawRatio = -0.05;
+        p.material.yieldStrain = 0.5;  // elastic here: the energy is a potential
+        p.material.expansion = 0.01;   // and a warm, softened sheet
+        p.material.stiffnessLoss = 0.3;
+        p.diffusion.initial = 0.5;
+        Membrane m(p);
         jitter(m, 3e-3, 9);
         std::vector<Eigen::Vector3d> f;
         m.computeForces(f);
@@ -108,8 +126,58 @@ TEST(Solvers, FemAndSphForcesAreMinusTheGradientOfTheStrainEnergy) {
                 m.positions()[i][a] = keep;
                 worst = std::max(worst, std::abs(-(up - down) / (2 * h) - f[i][a]));
             }
-        EXPECT_LT(worst, 1e-6 * maxNorm(f)) << nameOf(s);
+        EXPECT_LT(worst, 1e-6 * maxNorm(f)) << nameOf(s) << " law " << int(law);
     }
+}
+
+TEST(Solvers, ThePeridynamicBondsAreASolverOnTheMembranesOwnBonds) {
+    // The default solver is the paper's bonds behind the same interface: they break the shared
+    // bonds in place (advance() returns no edges), report the power law's stiffening in
+    // compression, and give the damage field eq. 27's strength left of yielded bonds.
+    MembraneParams p = sheet(SolverKind::Peridynamic, 0.3, 0.2, 0.2);
+    p.material.fractureEnergy = 0.02;
+    Membrane m(p);
+    const auto* bonds = dynamic_cast<const PeridynamicBonds*>(&m.solver());
+    ASSERT_NE(bonds, nullptr);
+    EXPECT_EQ(bonds->criticalStretch(), m.criticalStretch());
+
+    Lattice lattice = generateLattice(p.sheet);
+    BondFamilies shared = buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx);
+    const std::vector<double> volumes(lattice.positions.size(),
+                                      lattice.particleArea * p.sheet.thickness);
+    PeridynamicBonds solver(p, lattice, shared, lattice.positions, volumes);
+    std::vector<Eigen::Vector3d> x = lattice.positions, v(x.size(), Eigen::Vector3d::Zero()), f;
+    const double etaC = solver.criticalStretch();
+    for (auto& xi : x) xi.x() *= 1.0 + 1.01 * etaC;  // every x-leaning bond past eta_c
+    f.resize(x.size());
+    EXPECT_TRUE(solver.advance(x, v, 1e-3, f).empty());
+    const auto broken = std::count(shared.alive.begin(), shared.alive.end(), 0);
+    EXPECT_GT(broken, 0);
+    for (auto& xi : x) xi.x() /= 1.0 + 1.01 * etaC;  // back to rest: nothing heals
+    solver.advance(x, v, 1e-3, f);
+    EXPECT_EQ(std::count(shared.alive.begin(), shared.alive.end(), 0), broken);
+
+    p.material.fractureEnergy.reset();
+    p.material.law = BondLawKind::PowerLaw;
+    PeridynamicBonds rubber(p, lattice, shared, lattice.positions, volumes);
+    x = lattice.positions;
+    for (auto& xi : x) xi *= 0.8;
+    rubber.advance(x, v, 1e-3, f);
+    EXPECT_NEAR(rubber.stiffening(), rubber.law().powerLawStiffening(-0.2), 1e-9)
+        << "the most compressed bond sets the sub-steps";
+
+    p.material.law = BondLawKind::Elastoplastic;
+    p.material.yieldStrain = 0.01;
+    Membrane foil(p);
+    for (int i = 0; i < foil.particleCount(); ++i)
+        foil.positions()[i] = 1.03 * foil.restPositions()[i];
+    foil.step();
+    foil.updateDamage();
+    const double gamma = foil.law().strengthLeft({0.03});
+    EXPECT_LT(gamma, 1.0);
+    const int centre = foil.nearestParticle({0, 0});
+    EXPECT_NEAR(foil.damage()[centre], 1.0 - gamma, 0.02)
+        << "every bond yielded to about 3%: damage is 1 - gamma";
 }
 
 TEST(Solvers, UniaxialStressPatchIsInEquilibriumAndCarriesE) {

@@ -1,0 +1,252 @@
+#include "sim/PeridynamicBonds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "sim/Fracture.h"
+#include "sim/Parallel.h"
+
+namespace rend::sim {
+
+PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& lattice,
+                                   BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
+                                   std::span<const double> volumes)
+    : bonds_(bonds),
+      rest_(rest),
+      volume_(volumes),
+      material_(params.material),
+      horizon_(params.sheet.horizonFactor * params.sheet.dx) {
+    computeBondScales(params, lattice.particleArea);
+    setUpFracture(params.material);
+}
+
+void PeridynamicBonds::computeBondScales(const MembraneParams& params, double particleArea) {
+    const int n = bonds_.particleCount();
+    const bool paper = params.material.micromodulus == MicromodulusMode::Paper;
+    bondScale_.resize(bonds_.directedCount());
+    for (int i = 0; i < n; ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            // Literal eq. 22 multiplies by the area A_j; the consistent form by V_i V_j.
+            const double measure = paper ? particleArea : volume_[i] * volume_[j];
+            bondScale_[b] = bonds_.weight[b] * measure / bonds_.restLength[b];
+        }
+    const double interiorWeightedVolume = interiorFamilySum(
+        bonds_, [&](int b) { return bonds_.weight[b] * volume_[bonds_.partners[b]]; });
+    if (interiorWeightedVolume <= 0.0)
+        throw std::invalid_argument(
+            "no particle has a bond with non-zero weight: raise the horizon");
+    if (params.material.surfaceCorrection) applySurfaceCorrection();
+    const MaterialParams& m = params.material;
+    const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
+                           : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
+    law_ = BondLaw::fromMaterial(m, c);
+}
+
+std::vector<double> PeridynamicBonds::stiffnessRowSums(int particleCount) const {
+    std::vector<double> k(particleCount, 0.0);
+    for (int i = 0; i < particleCount; ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            k[i] += bondScale_[b] * law_.stiffness() / bonds_.restLength[b];
+    return k;
+}
+
+namespace {
+
+// Strain energy density of particle i under unit uniaxial stress along axis a, up to a constant
+// common to all particles: sum_j W0 V_j |xi| s^2 (the linear law's micropotential c s^2 |xi| / 2),
+// with the bond stretch s = n.eps.n of the plane-stress strain eps = a a - (1/3) a' a' (nu = 1/3)
+// and W0 V_j |xi| written through the bond scale W0 V_i V_j / |xi| of equal particle volumes.
+double uniaxialStressEnergy(const BondFamilies& bonds, const std::vector<double>& bondScale,
+                            std::span<const Eigen::Vector3d> x0, int i, int a) {
+    double sum = 0.0;
+    for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+        const Eigen::Vector3d n = (x0[bonds.partners[b]] - x0[i]) / bonds.restLength[b];
+        const double along = n[a] * n[a];
+        const double s = along - (1.0 - along) / 3.0;
+        sum += bondScale[b] * bonds.restLength[b] * bonds.restLength[b] * s * s;
+    }
+    return sum;
+}
+
+}  // namespace
+
+void PeridynamicBonds::applySurfaceCorrection() {
+    const int n = bonds_.particleCount();
+    // Energy method (Madenci & Oterkus 2014, Sec. 4.2) with uniaxial stress, not strain, as the
+    // loading: an edge is free of stress across it, so that is the state its particles meet.
+    std::vector<Eigen::Vector2d> factor(n, Eigen::Vector2d::Ones());
+    for (int a = 0; a < 2; ++a) {
+        std::vector<double> energy(n);
+        double interior = 0.0;
+        for (int i = 0; i < n; ++i) {
+            energy[i] = uniaxialStressEnergy(bonds_, bondScale_, rest_, i, a);
+            interior = std::max(interior, energy[i]);
+        }
+        for (int i = 0; i < n; ++i)
+            if (energy[i] > 0.0) factor[i][a] = interior / energy[i];
+    }
+    // The ends' mean keeps the bond symmetric (equal and opposite forces); the ellipse through
+    // the x and y factors gives the factor along the bond's direction n.
+    for (int i = 0; i < n; ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            const Eigen::Vector3d d = (rest_[j] - rest_[i]) / bonds_.restLength[b];
+            const Eigen::Vector2d g = 0.5 * (factor[i] + factor[j]);
+            bondScale_[b] /= std::hypot(d.x() / g.x(), d.y() / g.y());
+        }
+}
+
+void PeridynamicBonds::setUpFracture(const MaterialParams& m) {
+    criticalStretch_ = std::numeric_limits<double>::infinity();
+    if (m.fractureEnergy) {
+        const double interiorMoment = interiorFamilySum(bonds_, [&](int b) {  // sum_j W0 |xi| V_j
+            return bonds_.weight[b] * bonds_.restLength[b] * volume_[bonds_.partners[b]];
+        });
+        criticalStretch_ =
+            m.criticalStretch == CriticalStretchMode::Paper
+                ? paperCriticalStretch(*m.fractureEnergy, m.youngsModulus, horizon_)
+                : calibratedCriticalStretch(*m.fractureEnergy, law_.c, interiorMoment);
+    }
+    if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
+}
+
+double PeridynamicBonds::mechanicalStrain(int i, int b, double length, double& thetaBar) const {
+    const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+    if (theta_.empty()) {
+        thetaBar = 0.0;
+        return eta;
+    }
+    // The printed eqs. 18-20 use theta_j alone; the mean is symmetric, so the pair forces stay
+    // equal and opposite and momentum is conserved.
+    thetaBar = 0.5 * (theta_[i] + theta_[bonds_.partners[b]]);
+    return eta - material_.expansion * thetaBar;
+}
+
+// Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
+// Both copies of a bond see the same strain bit for bit, so they break and yield together.
+template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
+void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
+                                     std::vector<Eigen::Vector3d>& force) {
+    const int n = bonds_.particleCount();
+    force.resize(n);
+    const auto& offsets = bonds_.offsets;
+    const MaterialParams& m = material_;
+    double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
+#pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        const Eigen::Vector3d xi = x[i];
+        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
+            if (!bonds_.alive[b]) continue;
+            const int j = bonds_.partners[b];
+            const Eigen::Vector3d r = x[j] - xi;
+            const double length = r.norm();
+            double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+            double thetaBar = 0.0;
+            if constexpr (kTheta) {  // see mechanicalStrain()
+                thetaBar = 0.5 * (theta_[i] + theta_[j]);
+                eta -= m.expansion * thetaBar;
+            }
+            if constexpr (kBreak) {  // eq. 27/28
+                double limit = criticalStretch_;
+                if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
+                if (eta > limit) {
+                    if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
+                    continue;
+                }
+            }
+            PlasticState state;
+            if constexpr (kLaw == BondLawKind::Elastoplastic) {
+                state = law_.yieldStep(eta, plastic_[b]);
+                if constexpr (kUpdateBonds) plastic_[b] = state;
+            }
+            if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
+                if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
+                    const auto& v = *velocities_;
+                    const double rate = r.dot(v[j] - v[i]) / (length * bonds_.restLength[b]);
+                    lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
+                }
+            }
+            double f = law_.forceAs<kLaw>(eta, state);
+            if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
+            sum += (bondScale_[b] * f / length) * r;
+        }
+        force[i] = sum;
+    }
+    if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw)
+        stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
+}
+
+template <bool kUpdateBonds>
+void PeridynamicBonds::bondForces(const std::vector<Eigen::Vector3d>& x,
+                                  std::vector<Eigen::Vector3d>& force) {
+    const bool theta = !theta_.empty();
+    const bool breakable = std::isfinite(criticalStretch_);
+    auto forLaw = [&]<BondLawKind kLaw>() {
+        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(x, force);
+        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(x, force);
+        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(x, force);
+        if (!theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, false, false>(x, force);
+    };
+    switch (law_.kind) {
+        case BondLawKind::Linear:
+            return forLaw.template operator()<BondLawKind::Linear>();
+        case BondLawKind::PowerLaw:
+            return forLaw.template operator()<BondLawKind::PowerLaw>();
+        case BondLawKind::Elastoplastic:
+            return forLaw.template operator()<BondLawKind::Elastoplastic>();
+    }
+}
+
+void PeridynamicBonds::forces(const std::vector<Eigen::Vector3d>& x,
+                              std::vector<Eigen::Vector3d>& force) const {
+    // With kUpdateBonds = false the loop writes nothing but `force`.
+    const_cast<PeridynamicBonds*>(this)->bondForces<false>(x, force);
+}
+
+std::vector<std::array<int, 2>> PeridynamicBonds::advance(const std::vector<Eigen::Vector3d>& x,
+                                                          const std::vector<Eigen::Vector3d>& v,
+                                                          double dt,
+                                                          std::vector<Eigen::Vector3d>& force) {
+    velocities_ = &v;
+    dt_ = dt;
+    bondForces<true>(x, force);
+    return {};  // the shared bonds broke in place
+}
+
+double PeridynamicBonds::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+    double sum = 0.0;
+    for (int i = 0; i < bonds_.particleCount(); ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            if (!bonds_.alive[b]) continue;
+            double thetaBar;
+            const double length = (x[bonds_.partners[b]] - x[i]).norm();
+            const double eta = mechanicalStrain(i, b, length, thetaBar);
+            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
+            // Each bond is stored from both ends: half of U_ij from each.
+            sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
+                   degradation(material_.stiffnessLoss, thetaBar) * law_.energy(eta, state);
+        }
+    return sum;
+}
+
+Eigen::Matrix3d PeridynamicBonds::particleStress(int i,
+                                                 const std::vector<Eigen::Vector3d>& x) const {
+    Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+    for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+        if (!bonds_.alive[b]) continue;
+        const Eigen::Vector3d r = x[bonds_.partners[b]] - x[i];
+        const double length = r.norm();
+        double thetaBar;
+        const double eta = mechanicalStrain(i, b, length, thetaBar);
+        const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
+        const double f = degradation(material_.stiffnessLoss, thetaBar) * law_.force(eta, state);
+        sigma += (bondScale_[b] * f / length) * r * r.transpose();
+    }
+    return sigma / (2.0 * volume_[i]);
+}
+
+}  // namespace rend::sim

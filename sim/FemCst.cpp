@@ -38,7 +38,8 @@ struct Principal {
 Principal principal(const Eigen::Matrix2d& a) {
     const double offDiagonal = 0.5 * (a(0, 1) + a(1, 0));
     const double mean = 0.5 * (a(0, 0) + a(1, 1)), half = 0.5 * (a(0, 0) - a(1, 1));
-    const double radius = std::hypot(half, offDiagonal);
+    const double radius =
+        std::sqrt(half * half + offDiagonal * offDiagonal);  // strains: no overflow
     Principal p{{mean + radius, mean - radius}, Eigen::Matrix2d::Identity()};
     if (radius > 0.0) {  // (a - value_0 I) v = 0, from whichever row keeps v far from zero
         Eigen::Vector2d v = half >= 0.0 ? Eigen::Vector2d(half + radius, offDiagonal)
@@ -165,8 +166,16 @@ Eigen::Matrix2d FemCst::greenStrain(int t, const std::vector<Eigen::Vector3d>& x
 
 void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
                     std::vector<Eigen::Vector3d>& force) const {
+    elementForces(x, force, nullptr, 0.0);
+}
+
+double FemCst::elementForces(const std::vector<Eigen::Vector3d>& x,
+                             std::vector<Eigen::Vector3d>& force,
+                             const std::vector<Eigen::Vector3d>* v, double dt) const {
     const int elements = int(elements_.size());
-#pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
+    double lowest = 0.0;
+#pragma omp parallel for schedule(static) reduction(min \
+                                                    : lowest) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {
         const Element& e = elements_[t];
         if (!alive_[t]) {
@@ -184,7 +193,12 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
             S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
                 (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
         } else {
-            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) * nonlinearStress(t, F, nullptr);
+            const bool ahead = v && law_.kind == BondLawKind::PowerLaw;
+            Eigen::Matrix<double, 3, 2> rate;
+            if (ahead) rate = deformationGradient(e, *v) / stretch;
+            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
+                nonlinearStress(t, F, nullptr, ahead ? &rate : nullptr, dt,
+                                ahead ? &lowest : nullptr);
         }
         const Eigen::Matrix<double, 3, 2> H =
             -e.restArea * thickness_ / stretch * F * S * e.restInverse.transpose();
@@ -200,6 +214,7 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
             sum += cornerForce_[corners_[k]];
         force[i] = sum;
     }
+    return lowest;
 }
 
 std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
@@ -235,12 +250,20 @@ void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
     }
 }
 
-Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F,
-                                        double* energy) const {
+Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+                                        const Eigen::Matrix<double, 3, 2>* rate, double dt,
+                                        double* lowest) const {
     const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
     Eigen::Vector2d l, e;
     stretchesOf(c.value, l, e);
     const Eigen::Matrix2d& V = c.vectors;
+    if (lowest) {  // where each principal strain will be in dt if it keeps closing
+        for (int k = 0; k < 2; ++k) {
+            // dl/dt = (F n) . (dF/dt n) / l along the principal direction n.
+            const double closing = rate ? (F * V.col(k)).dot(*rate * V.col(k)) / l[k] : 0.0;
+            *lowest = std::min(*lowest, e[k] + std::min(0.0, dt * closing));
+        }
+    }
     Eigen::Matrix2d biot;  // Biot stress in U's eigenbasis
     if (law_.kind == BondLawKind::PowerLaw) {
         // W = 1/2 q^T D q with D = [[lambda* + 2 mu, lambda*], [lambda*, lambda* + 2 mu]].
@@ -346,31 +369,11 @@ std::vector<std::array<int, 2>> FemCst::advance(const std::vector<Eigen::Vector3
                                                 const std::vector<Eigen::Vector3d>& v, double dt,
                                                 std::vector<Eigen::Vector3d>& force) {
     std::vector<std::array<int, 2>> apart = fracture(x);
-    forces(x, force);
-    stiffening_ = 1.0;
-    if (law_.kind != BondLawKind::PowerLaw) return apart;
-    // The most compressed principal stretch, where it will be in dt if it keeps closing:
-    // dl/dt = (F n) . (dF/dt n) / l along the principal direction n.
-    double lowest = 0.0;
-    const int elements = int(elements_.size());
-#pragma omp parallel for schedule(static) reduction(min \
-                                                    : lowest) if (elements >= kParallelThreshold)
-    for (int t = 0; t < elements; ++t) {
-        if (!alive_[t]) continue;
-        const Element& e = elements_[t];
-        const double stretch = 1.0 + expansion_ * thetaOf(e);
-        const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x) / stretch;
-        const Eigen::Matrix<double, 3, 2> rate = deformationGradient(e, v) / stretch;
-        const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
-        Eigen::Vector2d l, strain;
-        stretchesOf(c.value, l, strain);
-        for (int k = 0; k < 2; ++k) {
-            const Eigen::Vector2d n = c.vectors.col(k);
-            const double closing = (F * n).dot(rate * n) / l[k];
-            lowest = std::min(lowest, strain[k] + std::min(0.0, dt * closing));
-        }
-    }
-    stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
+    const double lowest = elementForces(x, force, &v, dt);
+    // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
+    stiffening_ = law_.kind == BondLawKind::PowerLaw
+                      ? std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)))
+                      : 1.0;
     return apart;
 }
 

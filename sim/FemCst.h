@@ -99,8 +99,15 @@ private:
     /// Power law and elastoplastic: the second Piola stress S of element t at the mechanical
     /// deformation F (thermal stretch removed), before the stiffness loss; energy density into
     /// `energy` when asked.
-    Eigen::Matrix2d nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F,
-                                    double* energy) const;
+    /// With `lowest`, also lowers it to the smallest principal Biot strain, looked ahead by dt
+    /// at the rate dF/dt = `rate` (when given).
+    Eigen::Matrix2d nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+                                    const Eigen::Matrix<double, 3, 2>* rate = nullptr,
+                                    double dt = 0.0, double* lowest = nullptr) const;
+    /// forces(), with velocities v for the power law's look-ahead; returns the smallest
+    /// principal Biot strain (0 when none is compressed; linear law: 0).
+    double elementForces(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& force,
+                         const std::vector<Eigen::Vector3d>* v, double dt) const;
     /// Elastoplastic history step of element t at the mechanical deformation F.
     void yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F);
 

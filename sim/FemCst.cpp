@@ -22,13 +22,92 @@ void triangleIncidence(const std::vector<std::array<int, 3>>& triangles, int par
         for (int c = 0; c < 3; ++c) corners[fill[triangles[t][c]]++] = 3 * t + c;
 }
 
+namespace {
+
+/// A guard, not physics: a principal stretch below this (an element squashed to 5%) is held
+/// there, as Membrane's power-law look-ahead holds the strain at -0.95.
+constexpr double kMinStretch = 0.05;
+
+/// Eigen-decomposition of a symmetric 2x2 matrix in closed form: values largest first, unit
+/// eigenvectors as the columns of a rotation (the identity when the values are equal).
+struct Principal {
+    Eigen::Vector2d value;
+    Eigen::Matrix2d vectors;
+};
+
+Principal principal(const Eigen::Matrix2d& a) {
+    const double offDiagonal = 0.5 * (a(0, 1) + a(1, 0));
+    const double mean = 0.5 * (a(0, 0) + a(1, 1)), half = 0.5 * (a(0, 0) - a(1, 1));
+    const double radius =
+        std::sqrt(half * half + offDiagonal * offDiagonal);  // strains: no overflow
+    Principal p{{mean + radius, mean - radius}, Eigen::Matrix2d::Identity()};
+    if (radius > 0.0) {  // (a - value_0 I) v = 0, from whichever row keeps v far from zero
+        Eigen::Vector2d v = half >= 0.0 ? Eigen::Vector2d(half + radius, offDiagonal)
+                                        : Eigen::Vector2d(offDiagonal, radius - half);
+        v.normalize();
+        p.vectors << v.x(), -v.y(), v.y(), v.x();
+    }
+    return p;
+}
+
+/// Principal stretches l_k and Biot strains e_k = l_k - 1 from the principal Green strains
+/// g_k = (l_k^2 - 1) / 2; e_k = 2 g_k / (1 + l_k) keeps the digits of a small strain.
+void stretchesOf(const Eigen::Vector2d& green, Eigen::Vector2d& stretch, Eigen::Vector2d& strain) {
+    for (int k = 0; k < 2; ++k) {
+        const double square = 1.0 + 2.0 * green[k];
+        if (square > kMinStretch * kMinStretch) {
+            stretch[k] = std::sqrt(square);
+            strain[k] = 2.0 * green[k] / (1.0 + stretch[k]);
+        } else {
+            stretch[k] = kMinStretch;
+            strain[k] = kMinStretch - 1.0;
+        }
+    }
+}
+
+/// s^n - 1 - n e with s = 1 + e, by the binomial series where the closed form would cancel
+/// (small e), and exactly for a whole n (the series ends).
+double powerExcess(double e, double n) {
+    const bool whole = n == std::floor(n) && n <= 16.0;
+    if (!whole && std::abs(e) >= 0.1) return std::expm1(n * std::log1p(e)) - n * e;
+    double term = 0.5 * n * (n - 1.0) * e * e, sum = term;
+    for (int k = 2; k < 64 && term != 0.0; ++k) {
+        term *= (n - k) / (k + 1) * e;
+        sum += term;
+        if (!whole && std::abs(term) <= 1e-17 * std::abs(sum)) break;
+    }
+    return sum;
+}
+
+/// The power law's shape at unit stiffness (eq. 19 with c = 1): its energy Phi(e) and the
+/// strain measure q(e) = sign(e) sqrt(2 Phi(e)) with its derivative q' = Phi'/q (1 at rest).
+struct PowerShape {
+    double q, slope, energy;
+};
+
+PowerShape powerShape(const BondLaw& law, double e) {
+    const double s = 1.0 + e, n = law.powerN;
+    const double w = e * (2.0 + e) / s;  // s - 1/s without cancellation
+    const double energy = law.powerC * w * w + law.powerCStar * powerExcess(e, n);
+    const double force =
+        2.0 * law.powerC * w * (1.0 + 1.0 / (s * s)) +
+        law.powerCStar * n * (n == 2.0 ? e : std::expm1((n - 1.0) * std::log1p(e)));
+    // Past the peak of a softening law (c* < 0, large n) Phi can fall to 0: nothing is stored.
+    if (!(energy > 0.0)) return {0.0, e == 0.0 ? 1.0 : 0.0, 0.0};
+    const double q = std::copysign(std::sqrt(2.0 * energy), e);
+    return {q, force / q, energy};
+}
+
+}  // namespace
+
 FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double thickness,
                double criticalStrain)
     : thickness_(thickness),
       criticalStrain_(criticalStrain),
       expansion_(material.expansion),
       stiffnessLoss_(material.stiffnessLoss),
-      strengthLoss_(material.strengthLoss) {
+      strengthLoss_(material.strengthLoss),
+      law_(BondLaw::fromMaterial(material, 1.0)) {
     const double nu = material.poissonRatio;
     if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("fem_cst needs -1 < poisson < 0.5");
     lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
@@ -54,6 +133,10 @@ FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double th
     for (const Element& e : elements_) kept.push_back(e.v);
     triangleIncidence(kept, int(p.size()), cornerOffsets_, corners_);
     cornerForce_.resize(3 * elements_.size());
+    if (law_.kind == BondLawKind::Elastoplastic) {
+        plasticStrain_.assign(elements_.size(), Eigen::Matrix2d::Zero());
+        maxStrain_.assign(elements_.size(), 0.0);
+    }
 }
 
 void FemCst::findNeighbours() {
@@ -83,8 +166,16 @@ Eigen::Matrix2d FemCst::greenStrain(int t, const std::vector<Eigen::Vector3d>& x
 
 void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
                     std::vector<Eigen::Vector3d>& force) const {
+    elementForces(x, force, nullptr, 0.0);
+}
+
+double FemCst::elementForces(const std::vector<Eigen::Vector3d>& x,
+                             std::vector<Eigen::Vector3d>& force,
+                             const std::vector<Eigen::Vector3d>* v, double dt) const {
     const int elements = int(elements_.size());
-#pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
+    double lowest = 0.0;
+#pragma omp parallel for schedule(static) reduction(min \
+                                                    : lowest) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {
         const Element& e = elements_[t];
         if (!alive_[t]) {
@@ -96,10 +187,19 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
         // Psi(F / s), whose derivative is P(F / s) / s.
         const double theta = thetaOf(e), stretch = 1.0 + expansion_ * theta;
         const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x) / stretch;
-        const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
-        const Eigen::Matrix2d S =
-            std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
-            (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
+        Eigen::Matrix2d S;
+        if (law_.kind == BondLawKind::Linear) {
+            const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
+                (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
+        } else {
+            const bool ahead = v && law_.kind == BondLawKind::PowerLaw;
+            Eigen::Matrix<double, 3, 2> rate;
+            if (ahead) rate = deformationGradient(e, *v) / stretch;
+            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
+                nonlinearStress(t, F, nullptr, ahead ? &rate : nullptr, dt,
+                                ahead ? &lowest : nullptr);
+        }
         const Eigen::Matrix<double, 3, 2> H =
             -e.restArea * thickness_ / stretch * F * S * e.restInverse.transpose();
         cornerForce_[3 * t + 1] = H.col(0);
@@ -114,6 +214,7 @@ void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
             sum += cornerForce_[corners_[k]];
         force[i] = sum;
     }
+    return lowest;
 }
 
 std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
@@ -149,8 +250,73 @@ void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
     }
 }
 
+Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+                                        const Eigen::Matrix<double, 3, 2>* rate, double dt,
+                                        double* lowest) const {
+    const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
+    Eigen::Vector2d l, e;
+    stretchesOf(c.value, l, e);
+    const Eigen::Matrix2d& V = c.vectors;
+    if (lowest) {  // where each principal strain will be in dt if it keeps closing
+        for (int k = 0; k < 2; ++k) {
+            // dl/dt = (F n) . (dF/dt n) / l along the principal direction n.
+            const double closing = rate ? (F * V.col(k)).dot(*rate * V.col(k)) / l[k] : 0.0;
+            *lowest = std::min(*lowest, e[k] + std::min(0.0, dt * closing));
+        }
+    }
+    Eigen::Matrix2d biot;  // Biot stress in U's eigenbasis
+    if (law_.kind == BondLawKind::PowerLaw) {
+        // W = 1/2 q^T D q with D = [[lambda* + 2 mu, lambda*], [lambda*, lambda* + 2 mu]].
+        const PowerShape a = powerShape(law_, e[0]), b = powerShape(law_, e[1]);
+        const double da = (lambda_ + 2.0 * mu_) * a.q + lambda_ * b.q;
+        const double db = lambda_ * a.q + (lambda_ + 2.0 * mu_) * b.q;
+        biot << da * a.slope, 0.0, 0.0, db * b.slope;
+        if (energy) *energy = 0.5 * (a.q * da + b.q * db);
+    } else {
+        const Eigen::Matrix2d elastic =
+            V * e.asDiagonal() * V.transpose() - plasticStrain_[t];  // (U - I) - Ep
+        const Eigen::Matrix2d hooke =
+            lambda_ * elastic.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * elastic;
+        biot = V.transpose() * hooke * V;
+        if (energy)
+            *energy = 0.5 * lambda_ * elastic.trace() * elastic.trace() +
+                      mu_ * (elastic.array() * elastic.array()).sum();
+    }
+    Eigen::Matrix2d S;  // 2 T_ij / (l_i + l_j): the chain rule through U dU + dU U = dC
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) S(i, j) = 2.0 * biot(i, j) / (l[i] + l[j]);
+    return V * S * V.transpose();
+}
+
+void FemCst::yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F) {
+    const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
+    Eigen::Vector2d l, e;
+    stretchesOf(c.value, l, e);
+    const Principal elastic =
+        principal(c.vectors * e.asDiagonal() * c.vectors.transpose() - plasticStrain_[t]);
+    // The total strain along the most stretched elastic direction, the bond's eta of eq. 20.
+    const double before = law_.plasticStrain({maxStrain_[t]});
+    const double trial = elastic.value[0] + before;
+    if (!(trial > maxStrain_[t])) return;
+    maxStrain_[t] = trial;
+    const double flow = law_.plasticStrain({trial}) - before;
+    if (flow != 0.0) {
+        const Eigen::Vector2d n = elastic.vectors.col(0);
+        plasticStrain_[t] += flow * n * n.transpose();
+    }
+}
+
 std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
     std::vector<std::array<int, 2>> apart;
+    if (!maxStrain_.empty()) {  // eq. 20's history, per element, independent of the others
+        const int elements = int(elements_.size());
+#pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
+        for (int t = 0; t < elements; ++t) {
+            if (!alive_[t]) continue;
+            const double stretch = 1.0 + expansion_ * thetaOf(elements_[t]);
+            yieldElement(t, deformationGradient(elements_[t], x) / stretch);
+        }
+    }
     if (!std::isfinite(criticalStrain_)) return apart;
     for (int t = 0; t < int(elements_.size()); ++t) {
         if (!alive_[t]) continue;
@@ -188,10 +354,69 @@ double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
         const Eigen::Matrix2d E =
             0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
                    Eigen::Matrix2d::Identity());
+        double density;
+        if (law_.kind == BondLawKind::Linear)
+            density = 0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum();
+        else
+            nonlinearStress(t, deformationGradient(elements_[t], x) / stretch, &density);
         sum += elements_[t].restArea * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
-               (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
+               density;
     }
     return sum;
+}
+
+std::vector<std::array<int, 2>> FemCst::advance(const std::vector<Eigen::Vector3d>& x,
+                                                const std::vector<Eigen::Vector3d>& v, double dt,
+                                                std::vector<Eigen::Vector3d>& force) {
+    std::vector<std::array<int, 2>> apart = fracture(x);
+    const double lowest = elementForces(x, force, &v, dt);
+    // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
+    stiffening_ = law_.kind == BondLawKind::PowerLaw
+                      ? std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)))
+                      : 1.0;
+    return apart;
+}
+
+double FemCst::strengthLeft(int t) const {
+    return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t]});
+}
+
+void FemCst::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
+    bondEnds_.clear();
+    bondElements_.clear();
+    if (maxStrain_.empty()) return;  // only the elastoplastic law loses strength
+    std::map<std::pair<int, int>, std::array<int, 2>> holders;  // side -> its elements
+    for (int t = 0; t < int(elements_.size()); ++t)
+        for (int s = 0; s < 3; ++s) {
+            const auto key = std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]);
+            holders.try_emplace(key, std::array<int, 2>{t, elements_[t].across[s]});
+        }
+    bondEnds_.resize(partners.size());
+    bondElements_.assign(partners.size(), {-1, -1});
+    for (int i = 0; i + 1 < int(offsets.size()); ++i)
+        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
+            bondEnds_[b] = {i, partners[b]};
+            if (const auto it = holders.find(std::minmax(i, partners[b])); it != holders.end())
+                bondElements_[b] = it->second;
+        }
+}
+
+double FemCst::bondStrengthLeft(int bond) const {
+    if (bondEnds_.empty()) return 1.0;
+    double sum = 0.0;
+    int count = 0;
+    for (int t : bondElements_[bond])
+        if (t >= 0 && alive_[t]) sum += strengthLeft(t), ++count;
+    if (count > 0) return sum / count;
+    double ends = 0.0;
+    for (int i : bondEnds_[bond]) {  // a bond no element side carries: its ends' mean
+        double own = 0.0;
+        int held = 0;
+        for (int k = cornerOffsets_[i]; k < cornerOffsets_[i + 1]; ++k)
+            if (const int t = corners_[k] / 3; alive_[t]) own += strengthLeft(t), ++held;
+        ends += held > 0 ? own / held : 1.0;
+    }
+    return 0.5 * ends;
 }
 
 }  // namespace rend::sim

@@ -8,12 +8,36 @@
 // free (the bond-based model fixes 1/3). The nodal forces are the exact negative gradient of
 // the stored energy A0 h (lambda*/2 tr(E)^2 + mu E:E): H = -A0 h F S Dm^-T gives vertices 1 and
 // 2 as its columns, vertex 0 minus their sum.
+//
+// The membrane paper's other two bond laws (seeds/000, eqs. 19 and 20; sim/BondLaw.h) act on
+// the principal stretches l_k of C = F^T F = V diag(l_k^2) V^T through the Biot strains
+// e_k = l_k - 1, the strain the bonds and springs use. Both keep the linearisation of the
+// St. Venant-Kirchhoff element (same E, nu and rest stiffness), and under uniaxial stress both
+// give the nominal stress E f(e)/c of a bond, exactly:
+//   * Power law (eq. 19), hyperelastic: with Phi = Psi/c the bond energy at unit stiffness and
+//     q(e) = sign(e) sqrt(2 Phi(e)) (= e + O(e^2)), W = 1/2 q^T D q, D the plane-stress Hooke
+//     matrix on (q_1, q_2). Uniaxial stress (dW/dq_2 = 0) leaves dW/de_1 = E q q' = E Phi' =
+//     E f/c; equal biaxial strain gives E/(1-nu) f/c, as a bond family does. (The sum
+//     Phi(e_1) + Phi(e_2) + nu phi(e_1) phi(e_2) would miss the uniaxial curve by O(nu^2).)
+//   * Elastoplastic (eq. 20), Rankine-type softening plasticity: a plastic Biot strain Ep (2x2,
+//     rest frame) and the largest equivalent strain T per element; elastic strain
+//     Ee = (U - I) - Ep, U = sqrt(C), and Hooke's law T_B = lambda* tr(Ee) I + 2 mu Ee on it.
+//     The history step takes the largest principal value e1 of Ee (direction n1): the total
+//     strain along n1 is e1 + kappa(T), kappa(T) = T - f(T)/c the plastic strain of the bond
+//     law; past max(T, eta0) the element loads: T = e1 + kappa, Ep += dkappa n1 n1^T. Under
+//     uniaxial stress this is the bond's loading, softening and elastic unloading to the
+//     permanent strain kappa(T), exactly; the strength left f(T)/(c eta0) is eq. 27's gamma.
+// Both stresses are Biot stresses T_B (conjugate to U); with U dU + dU U = dC the second
+// Piola stress is S = V [2 T_B,ij / (l_i + l_j)] V^T in U's eigenbasis (T_k / l_k on the
+// diagonal), well defined when l_1 = l_2. Forces are the exact negative gradient of the energy
+// (at fixed plastic history).
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <array>
 #include <vector>
 
+#include "sim/BondLaw.h"
 #include "sim/Lattice.h"
 #include "sim/Params.h"
 #include "sim/Solver.h"
@@ -33,7 +57,18 @@ public:
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
+    /// Yields the elastoplastic elements (their history step), then erodes.
     std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    /// fracture(), forces(), and for the power law the stiffening of the most compressed
+    /// principal stretch, looked ahead by dt at its current rate.
+    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
+                                            const std::vector<Eigen::Vector3d>& v, double dt,
+                                            std::vector<Eigen::Vector3d>& force) override;
+    double stiffening() const override { return stiffening_; }
+    /// A bond along an element side: the mean gamma of the living elements holding it; any
+    /// other bond: the mean of its two ends' (each the mean over its living elements).
+    double bondStrengthLeft(int bond) const override;
+    void bindBonds(std::span<const int> offsets, std::span<const int> partners) override;
     /// A notch removes every element with a cut side (a gap one element wide).
     bool cut(const std::vector<std::array<int, 2>>& edges) override;
     std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
@@ -41,6 +76,10 @@ public:
     /// Green strain of triangle t at positions x, in its rest frame (first axis along edge 01).
     Eigen::Matrix2d greenStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
     int elementCount() const { return int(elements_.size()); }
+    /// Largest equivalent strain T the element reached (elastoplastic law; 0 otherwise).
+    double maxStrain(int t) const { return maxStrain_.empty() ? 0.0 : maxStrain_[t]; }
+    /// eq. 27's gamma of element t: 1 unless it has yielded and softened.
+    double strengthLeft(int t) const;
 
 private:
     struct Element {
@@ -57,6 +96,20 @@ private:
     void erode(int t, std::vector<std::array<int, 2>>& apart);
     Eigen::Matrix<double, 3, 2> deformationGradient(const Element& e,
                                                     const std::vector<Eigen::Vector3d>& x) const;
+    /// Power law and elastoplastic: the second Piola stress S of element t at the mechanical
+    /// deformation F (thermal stretch removed), before the stiffness loss; energy density into
+    /// `energy` when asked.
+    /// With `lowest`, also lowers it to the smallest principal Biot strain, looked ahead by dt
+    /// at the rate dF/dt = `rate` (when given).
+    Eigen::Matrix2d nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+                                    const Eigen::Matrix<double, 3, 2>* rate = nullptr,
+                                    double dt = 0.0, double* lowest = nullptr) const;
+    /// forces(), with velocities v for the power law's look-ahead; returns the smallest
+    /// principal Biot strain (0 when none is compressed; linear law: 0).
+    double elementForces(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& force,
+                         const std::vector<Eigen::Vector3d>* v, double dt) const;
+    /// Elastoplastic history step of element t at the mechanical deformation F.
+    void yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F);
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each
@@ -65,6 +118,13 @@ private:
     mutable std::vector<Eigen::Vector3d> cornerForce_;
     double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0, criticalStrain_ = 0.0;
     double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
+    BondLaw law_;  ///< the material's law at unit stiffness (c = 1): its shape f/c
+    // Elastoplastic history per element: plastic Biot strain (rest frame) and T.
+    std::vector<Eigen::Matrix2d> plasticStrain_;
+    std::vector<double> maxStrain_;
+    double stiffening_ = 1.0;
+    // bindBonds: per bond, its ends and the elements holding it as a side (-1: none).
+    std::vector<std::array<int, 2>> bondEnds_, bondElements_;
     std::vector<std::uint8_t> alive_;          ///< per element
     std::vector<std::uint8_t> triangleAlive_;  ///< per lattice triangle, for the FrameView
 };

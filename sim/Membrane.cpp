@@ -97,6 +97,7 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
 
 void Membrane::useSolver(std::unique_ptr<Solver> solver) {
     solver_ = std::move(solver);
+    solver_->bindBonds(bonds_.offsets, bonds_.partners);
     const std::vector<double> k = solver_->stiffnessRowSums(particleCount());
     double worstRatio = 0.0;
     for (int i = 0; i < particleCount(); ++i) worstRatio = std::max(worstRatio, k[i] / mass_[i]);

@@ -60,6 +60,11 @@ public:
     /// still has, for the damage field; 1 unless the solver keeps it per bond.
     virtual double bondStrengthLeft(int bond) const { return 1.0; }
 
+    /// The Membrane's bond families in CSR (bonds of particle i: [offsets[i], offsets[i+1]),
+    /// partner j), given once after construction, for a solver whose bondStrengthLeft() must
+    /// map a bond onto its own pieces. Ignored by default.
+    virtual void bindBonds(std::span<const int> offsets, std::span<const int> partners) {}
+
     /// Cuts the edges {i, j} at set-up (pre-notches). Returns false when the solver cannot
     /// represent a cut.
     virtual bool cut(const std::vector<std::array<int, 2>>& edges) { return edges.empty(); }

@@ -804,12 +804,13 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
-    // Van Gelder's springs take the bond laws; every solver takes notches and the coupling to
-    // theta, and all but the SPH fracture.
-    const bool vanGelder = p.solver == sim::SolverKind::MassSpringVanGelder;
+    // Every solver takes notches and the coupling to theta, all but the SPH fracture, and all
+    // but the two-parameter springs and the SPH the three bond laws.
+    const bool lawful = p.solver == sim::SolverKind::MassSpringVanGelder ||
+                        p.solver == sim::SolverKind::FemCst;
     const bool sph = p.solver == sim::SolverKind::Sph;
     if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
-    if (m.law != sim::BondLawKind::Linear && !vanGelder)
+    if (m.law != sim::BondLawKind::Linear && !lawful)
         wanted.push_back("a bond law other than linear");
     if (m.criticalStretch == sim::CriticalStretchMode::Paper)
         wanted.push_back("critical_stretch = \"paper\"");

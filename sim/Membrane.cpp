@@ -27,7 +27,7 @@ Membrane::Membrane(const MembraneParams& params)
     for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
     computeBondScales(params);
-    if (params.solver != SolverKind::Peridynamic) useSolver(makeSolver(params, lattice_));
+    if (params.solver != SolverKind::Peridynamic) useSolver(makeSolver(params, lattice_, &bonds_));
     setUpFracture(params);
     if (params.pressure != 0.0) {
         pressureEdgeBonds_.reserve(lattice_.triangles.size());
@@ -148,7 +148,8 @@ double springCriticalStrain(const MembraneParams& params) {
                      (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
 }
 
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
+std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice,
+                                   const BondFamilies* bonds) {
     const MaterialParams& m = params.material;
     const double h = params.sheet.thickness;
     const double critical = springCriticalStrain(params);
@@ -156,9 +157,11 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
         case SolverKind::FemCst:
             return std::make_unique<FemCst>(lattice, m, h, critical);
         case SolverKind::MassSpringVanGelder:
-            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
+            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical,
+                                                bonds);
         case SolverKind::MassSpringTwoParameter:
-            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h, critical);
+            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h, critical,
+                                                bonds);
         case SolverKind::Sph:
             if (params.sheet.outline == Outline::Sphere)
                 throw std::invalid_argument("the sph solver needs a flat rest sheet");

@@ -41,8 +41,10 @@ public:
 /// lattice row store the fracture energy G_f (infinity without one).
 double springCriticalStrain(const MembraneParams& params);
 
-/// The Solver a scene's `solver` names; nullptr for the built-in peridynamic bonds.
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
+/// The Solver a scene's `solver` names; nullptr for the built-in peridynamic bonds. `bonds`, the
+/// Membrane's, lets a solver that keeps per-bond history report it (Solver::bondStrengthLeft).
+std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice,
+                                   const BondFamilies* bonds = nullptr);
 
 class Membrane {
 public:

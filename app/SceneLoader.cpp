@@ -804,14 +804,11 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
-    // Every solver takes notches and the coupling to theta, all but the SPH fracture, and all
-    // but the two-parameter springs and the SPH the three bond laws.
-    const bool lawful = p.solver == sim::SolverKind::MassSpringVanGelder ||
-                        p.solver == sim::SolverKind::FemCst;
+    // Every solver takes notches and the coupling to theta, all but the SPH fracture and the
+    // three bond laws.
     const bool sph = p.solver == sim::SolverKind::Sph;
     if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
-    if (m.law != sim::BondLawKind::Linear && !lawful)
-        wanted.push_back("a bond law other than linear");
+    if (m.law != sim::BondLawKind::Linear && sph) wanted.push_back("a bond law other than linear");
     if (m.criticalStretch == sim::CriticalStretchMode::Paper)
         wanted.push_back("critical_stretch = \"paper\"");
 

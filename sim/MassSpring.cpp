@@ -21,8 +21,6 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
       criticalStrain_(criticalStrain) {
     if (!(poisson_ > -1.0 && poisson_ < 0.5))
         throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
-    if (model == SpringModel::TwoParameter && material.law != BondLawKind::Linear)
-        throw std::invalid_argument("the two-parameter springs are linear");
     const double E = material.youngsModulus, t = thickness, nu = poisson_;
     const auto& p = lattice.positions;
     std::map<std::pair<int, int>, int> index;
@@ -95,6 +93,51 @@ std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Ve
     return apart;
 }
 
+std::vector<std::array<int, 2>> MassSpring::advance(const std::vector<Eigen::Vector3d>& x,
+                                                    const std::vector<Eigen::Vector3d>& v,
+                                                    double dt,
+                                                    std::vector<Eigen::Vector3d>& force) {
+    std::vector<std::array<int, 2>> apart = fracture(x);
+    if (law_.kind == BondLawKind::PowerLaw)  // the clamp is the peridynamic loop's
+        stiffening_ =
+            std::max(1.0, law_.powerLawStiffening(std::max(lowestStrain(x, v, dt), -0.95)));
+    forces(x, force);
+    return apart;
+}
+
+void MassSpring::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
+    bondSpring_.assign(partners.size(), -1);
+    for (int s = 0; s < int(springs_.size()); ++s)
+        for (const auto& [a, b] :
+             {std::pair{springs_[s].i, springs_[s].j}, std::pair{springs_[s].j, springs_[s].i}})
+            for (int bond = offsets[a]; bond < offsets[a + 1]; ++bond)
+                if (partners[bond] == b) bondSpring_[bond] = s;
+}
+
+double MassSpring::bondStrengthLeft(int bond) const {
+    if (plastic_.empty() || bondSpring_.empty()) return 1.0;
+    const int s = bondSpring_[bond];
+    return s < 0 ? 1.0 : law_.strengthLeft(plastic_[s]);  // eq. 27's gamma of the side strain
+}
+
+double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
+                                const std::vector<Eigen::Vector3d>& v, double dt) const {
+    double lowest = 0.0;
+    const int count = int(springs_.size());
+#pragma omp parallel for schedule(static) reduction(min : lowest) if (count >= kParallelThreshold)
+    for (int s = 0; s < count; ++s) {
+        if (!springAlive_[s]) continue;
+        double thetaBar;
+        const double eta = mechanicalStrain(s, x, thetaBar);
+        if (eta >= 0.0) continue;
+        const Spring& sp = springs_[s];
+        const Eigen::Vector3d r = x[sp.j] - x[sp.i];
+        const double rate = r.dot(v[sp.j] - v[sp.i]) / (r.norm() * sp.restLength);
+        lowest = std::min(lowest, eta + std::min(0.0, dt * rate));
+    }
+    return lowest;
+}
+
 bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
     std::set<std::pair<int, int>> cuts;  // springs are stored with i < j
     for (const auto& [a, b] : edges) cuts.insert(std::minmax(a, b));
@@ -127,8 +170,48 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
         }
         return;
     }
-    // Two-parameter: each triangle's share of its three sides' tensions, then the sum per side
-    // in a fixed order (triangle by triangle), so the result does not depend on threads.
+    switch (law_.kind) {
+        case BondLawKind::Linear:
+            return twoParameterTensions<BondLawKind::Linear>(x);
+        case BondLawKind::PowerLaw:
+            return twoParameterTensions<BondLawKind::PowerLaw>(x);
+        case BondLawKind::Elastoplastic:
+            return twoParameterTensions<BondLawKind::Elastoplastic>(x);
+    }
+}
+
+MassSpring::SideStrains MassSpring::sideStrains(int k,
+                                                const std::vector<Eigen::Vector3d>& x) const {
+    const Triangle& tri = triangles_[k];
+    double theta = 0.0;
+    if (!theta_.empty()) theta = (theta_[tri.v[0]] + theta_[tri.v[1]] + theta_[tri.v[2]]) / 3;
+    return sideStrains(x, tri.v, tri.restLength, tri.restArea, theta);
+}
+
+MassSpring::SideStrains MassSpring::sideStrains(const std::vector<Eigen::Vector3d>& x,
+                                                const std::array<int, 3>& v,
+                                                const std::array<double, 3>& restLength,
+                                                double restArea, double theta) const {
+    SideStrains e;
+    e.theta = theta;
+    const Eigen::Vector3d& a = x[v[0]];
+    const double area = 0.5 * (x[v[1]] - a).cross(x[v[2]] - a).norm();
+    // The thermal strain scales the triangle's rest shape by s = 1 + alpha theta_bar: rest
+    // lengths and heights by s.
+    const double stretch = 1.0 + expansion_ * theta;
+    for (int s = 0; s < 3; ++s) {
+        const double l = (x[v[(s + 1) % 3]] - x[v[(s + 2) % 3]]).norm();
+        const double l0 = restLength[s];
+        e.tangent[s] = l / (l0 * stretch) - 1.0;
+        e.normal[s] = (area / l) / (restArea / l0 * stretch) - 1.0;
+    }
+    return e;
+}
+
+// Each triangle's share of its three sides' tensions, then the sum per side in a fixed order
+// (triangle by triangle), so the result does not depend on threads.
+template <BondLawKind K>
+void MassSpring::twoParameterTensions(const std::vector<Eigen::Vector3d>& x) const {
     const int triangles = int(triangles_.size());
 #pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
     for (int k = 0; k < triangles; ++k) {
@@ -137,31 +220,58 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
             triangleTension_[k] = {0.0, 0.0, 0.0};
             continue;
         }
-        const Eigen::Vector3d& a = x[tri.v[0]];
-        const double area = 0.5 * (x[tri.v[1]] - a).cross(x[tri.v[2]] - a).norm();
-        // The thermal strain scales the triangle's rest shape by s = 1 + alpha theta_bar: rest
-        // lengths and heights by s, so the forces (b0 Q a0^2 ~ s) by s too.
-        double theta = 0.0;
-        if (!theta_.empty()) theta = (theta_[tri.v[0]] + theta_[tri.v[1]] + theta_[tri.v[2]]) / 3;
-        const double stretch = 1.0 + expansion_ * theta;
+        SideStrains e = sideStrains(k, x);
+        // Elastoplastic: the rest triangle of sides l0 (1 + p), p the springs' permanent strains
+        // (on the loading path, eq. 20's at the current strain). Left at l0 while elastic.
+        std::array<double, 3> rest = tri.restLength;
+        double restArea = tri.restArea, fixedPart = tri.fixedPart;
+        if constexpr (K == BondLawKind::Elastoplastic) {
+            bool yielded = false;
+            for (int s = 0; s < 3; ++s) {
+                const double strain = e.tangent[s];
+                const double p = strain - law_.forceAs<K>(strain, plastic_[tri.side[s]]);
+                yielded = yielded || p != 0.0;
+                rest[s] *= 1.0 + p;
+            }
+            if (yielded) {
+                const double a = rest[0], b = rest[1], c = rest[2];  // Heron
+                const double heron = (a + b + c) * (-a + b + c) * (a - b + c) * (a + b - c);
+                restArea = 0.25 * std::sqrt(std::max(heron, 0.0));
+                // A plastic flow that flattens the triangle leaves it nothing to carry.
+                if (!(restArea > 1e-3 * tri.restArea)) {
+                    triangleTension_[k] = {0.0, 0.0, 0.0};
+                    continue;
+                }
+                fixedPart *= tri.restArea / restArea;  // eq. 12 for the new rest triangle
+                e = sideStrains(x, tri.v, rest, restArea, e.theta);
+            }
+        }
         std::array<double, 3> q, l0sq;
         for (int s = 0; s < 3; ++s) {
-            const double l = (x[tri.v[(s + 1) % 3]] - x[tri.v[(s + 2) % 3]]).norm();
-            const double l0 = tri.restLength[s];
-            const double tangent = l / (l0 * stretch) - 1.0;                         // eps_t
-            const double normal = (area / l) / (tri.restArea / l0 * stretch) - 1.0;  // eps_n
-            q[s] = normal + poisson_ * tangent;                                      // eq. 9
-            l0sq[s] = l0 * l0;
+            q[s] = e.normal[s] + poisson_ * e.tangent[s];  // eq. 9
+            l0sq[s] = rest[s] * rest[s];
         }
         const double all = l0sq[0] * q[0] + l0sq[1] * q[1] + l0sq[2] * q[2];
-        const double scale = stretch * std::max(0.0, 1.0 - stiffnessLoss_ * theta);
+        // The rest shape's scale s multiplies the forces (b0 Q a0^2 ~ s).
+        const double stretch = 1.0 + expansion_ * e.theta;
+        const double scale = stretch * std::max(0.0, 1.0 - stiffnessLoss_ * e.theta);
         for (int s = 0; s < 3; ++s)  // eqs. 13-14 times eps_b b0
-            triangleTension_[k][s] =
-                scale * tri.fixedPart * tri.restLength[s] * (all - 2.0 * l0sq[s] * q[s]);
+            triangleTension_[k][s] = scale * fixedPart * rest[s] * (all - 2.0 * l0sq[s] * q[s]);
     }
     std::fill(tension_.begin(), tension_.end(), 0.0);
     for (int k = 0; k < triangles; ++k)
         for (int s = 0; s < 3; ++s) tension_[triangles_[k].side[s]] += triangleTension_[k][s];
+    if constexpr (K == BondLawKind::PowerLaw) {  // each spring's secant phi(eta) / eta
+        const int count = int(springs_.size());
+#pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
+        for (int s = 0; s < count; ++s) {
+            double thetaBar;
+            const double eta = mechanicalStrain(s, x, thetaBar);
+            // Below 1e-6 the secant is 1 to within phi''(0) 1e-6: a part in a million of a
+            // tension that is itself a millionth of the stiffness.
+            if (std::abs(eta) > 1e-6) tension_[s] *= law_.forceAs<K>(eta) / eta;
+        }
+    }
 }
 
 void MassSpring::forces(const std::vector<Eigen::Vector3d>& x,

@@ -89,6 +89,12 @@ check "renderer none writes no frames" test ! -e "$tmp/none/frames"
 check "fem solver runs" run 0 run scenes/stretch.toml "${small[@]}" --set solver=fem_cst \
     --renderer none --out "$tmp/fem"
 check "fem run.json ok" grep -q '"status": "ok"' "$tmp/fem/run.json"
+for solver in fem_cst mass_spring_tp; do  # the foil's elastoplastic law and the film's power law
+    for scene in foil_tear rubber_film; do
+        check "$scene runs with $solver" run 0 run scenes/$scene.toml --set time.duration=0.3 \
+            --set solver=$solver --renderer none --out "$tmp/$scene-$solver"
+    done
+done
 check "sph refuses a sphere" run 2 run scenes/pressurised_sphere.toml --set solver=sph --out "$tmp/sphsphere"
 check "sph refusal names the solver" grep -q "solver: expected \"peridynamic\"" "$tmp/stderr"
 check "sph refusal leaves no output" test ! -e "$tmp/sphsphere"

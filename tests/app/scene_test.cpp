@@ -939,7 +939,12 @@ TEST_F(SceneTest, SolverIsChosenAtTheTopLevelAndRefusesWhatItCannotDo) {
                   .find("for a scene with fracture"),
               std::string::npos)
         << "the SPH does not break";
-    EXPECT_NE(errorOf(file, {"solver=mass_spring_tp", "material.law=power_law"})
+    for (const char* solver : {"fem_cst", "mass_spring_vg", "mass_spring_tp"})
+        EXPECT_EQ(loadScene(file, {std::string("solver=") + solver, "material.law=power_law"})
+                      .sim.material.law,
+                  sim::BondLawKind::PowerLaw)
+            << solver << " takes the bond laws";
+    EXPECT_NE(errorOf(file, {"solver=sph", "material.law=elastoplastic"})
                   .find("a bond law other than linear"),
               std::string::npos);
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 
@@ -132,47 +133,56 @@ void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
                                      std::vector<Eigen::Vector3d>& force) {
     const int n = bonds_.particleCount();
     force.resize(n);
-    const auto& offsets = bonds_.offsets;
+    // Raw arrays, loaded once: the stores to `alive` (a char type) and to `plastic` would
+    // otherwise make the compiler reload every vector's data pointer after each of them.
+    const int* offsets = bonds_.offsets.data();
+    const int* partners = bonds_.partners.data();
+    const double* restLength = bonds_.restLength.data();
+    const double* bondScale = bondScale_.data();
+    std::uint8_t* alive = bonds_.alive.data();
+    PlasticState* plastic = plastic_.data();
+    const Eigen::Vector3d* xs = x.data();
+    const double* theta = theta_.data();
+    const Eigen::Vector3d* v = velocities_ ? velocities_->data() : nullptr;
     const MaterialParams& m = material_;
     double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
 #pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        const Eigen::Vector3d xi = x[i];
+        const Eigen::Vector3d xi = xs[i];
         for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
-            if (!bonds_.alive[b]) continue;
-            const int j = bonds_.partners[b];
-            const Eigen::Vector3d r = x[j] - xi;
+            if (!alive[b]) continue;
+            const int j = partners[b];
+            const Eigen::Vector3d r = xs[j] - xi;
             const double length = r.norm();
-            double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
+            double eta = length / restLength[b] - 1.0;  // eq. 10
             double thetaBar = 0.0;
             if constexpr (kTheta) {  // see mechanicalStrain()
-                thetaBar = 0.5 * (theta_[i] + theta_[j]);
+                thetaBar = 0.5 * (theta[i] + theta[j]);
                 eta -= m.expansion * thetaBar;
             }
             if constexpr (kBreak) {  // eq. 27/28
                 double limit = criticalStretch_;
                 if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
                 if (eta > limit) {
-                    if constexpr (kUpdateBonds) bonds_.alive[b] = 0;
+                    if constexpr (kUpdateBonds) alive[b] = 0;
                     continue;
                 }
             }
             PlasticState state;
             if constexpr (kLaw == BondLawKind::Elastoplastic) {
-                state = law_.yieldStep(eta, plastic_[b]);
-                if constexpr (kUpdateBonds) plastic_[b] = state;
+                state = law_.yieldStep(eta, plastic[b]);
+                if constexpr (kUpdateBonds) plastic[b] = state;
             }
             if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
                 if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
-                    const auto& v = *velocities_;
-                    const double rate = r.dot(v[j] - v[i]) / (length * bonds_.restLength[b]);
+                    const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
                     lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
                 }
             }
             double f = law_.forceAs<kLaw>(eta, state);
             if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
-            sum += (bondScale_[b] * f / length) * r;
+            sum += (bondScale[b] * f / length) * r;
         }
         force[i] = sum;
     }

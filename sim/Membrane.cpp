@@ -87,8 +87,11 @@ std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& 
         case SolverKind::Sph:
             if (params.sheet.outline == Outline::Sphere)
                 throw std::invalid_argument("the sph solver needs a flat rest sheet");
-            return std::make_unique<TotalLagrangianSph>(lattice, params.sheet.dx, m, h,
-                                                        params.notches);
+            return std::make_unique<TotalLagrangianSph>(
+                lattice, params.sheet.dx, m, h, params.notches,
+                m.fractureEnergy
+                    ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, params.sheet.dx)
+                    : std::numeric_limits<double>::infinity());
         case SolverKind::Peridynamic:
             break;
     }

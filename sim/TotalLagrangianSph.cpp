@@ -19,17 +19,33 @@ double kernel(double r, double support) {
     return q >= 1.0 ? 0.0 : std::pow(1.0 - q, 4) * (4.0 * q + 1.0);
 }
 
+/// G / (E h dx e^2) of a straight crack on the hexagonal lattice, e the Green strain normal to it:
+/// 0.942 along a row, 1.002 across the rows (1.055 on the square lattice either way), measured
+/// by SphFracture.AStraightCrackReleasesTheFractureEnergy; the mean of the hexagonal two.
+constexpr double kCrackEnergyFactor = 0.97;
+
+/// A pair longer than this many times its rest length breaks whatever F says: F hardly sees a
+/// pair near the kernel's edge (weight ~ 0), which would otherwise tether a particle that tore
+/// away. Far above the pair lengths' zero-energy noise (< 2 e_c next to the grips).
+constexpr double kTetherStretch = 2.0;
+
 }  // namespace
+
+double sphCriticalStrain(double fractureEnergy, double youngsModulus, double dx) {
+    const double green = std::sqrt(fractureEnergy / (kCrackEnergyFactor * youngsModulus * dx));
+    return std::sqrt(1.0 + 2.0 * green) - 1.0;
+}
 
 TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
                                        const MaterialParams& material, double thickness,
-                                       std::span<const Notch> notches)
+                                       std::span<const Notch> notches, double criticalStrain)
     : rest_(lattice.positions),
       support_(kSupport * dx),
       expansion_(material.expansion),
       stiffnessLoss_(material.stiffnessLoss),
       strengthLoss_(material.strengthLoss),
-      thickness_(thickness) {
+      thickness_(thickness),
+      criticalStrain_(criticalStrain) {
     const double nu = material.poissonRatio;
     if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("sph needs -1 < poisson < 0.5");
     lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
@@ -48,6 +64,130 @@ TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             mirror_[k] = findBond(pairs_, neighbours_[k], i);
     stress_.resize(n);
+    restMetric_.assign(n, -1);
+    breaking_.assign(neighbours_.size(), 0);
+    // The pairs that are also sides of rest triangles: their breaking is reported to Membrane
+    // (the FrameView's cracks) and removes the triangles on either side.
+    latticeEdge_.assign(neighbours_.size(), 0);
+    triangleSidePairs_.reserve(lattice.triangles.size());
+    for (const auto& t : lattice.triangles) {
+        std::array<int, 3> side{};
+        for (int s = 0; s < 3; ++s) {
+            const int a = t[(s + 1) % 3], b = t[(s + 2) % 3];
+            side[s] = findBond(pairs_, a, b);
+            if (side[s] >= 0) latticeEdge_[side[s]] = latticeEdge_[mirror_[side[s]]] = 1;
+        }
+        triangleSidePairs_.push_back(side);
+    }
+    if (std::isfinite(criticalStrain_)) triangleAlive_.assign(lattice.triangles.size(), 1);
+}
+
+bool TotalLagrangianSph::pairAlive(int i, int j) const {
+    const int k = findBond(pairs_, i, j);
+    return k >= 0 && pairs_.alive[k];
+}
+
+std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
+    const std::vector<Eigen::Vector3d>& x) {
+    if (!std::isfinite(criticalStrain_)) return {};
+    const int n = int(x.size());
+    deformations(x);
+    // The pair's stretch seen through the mean of its ends' mechanical F, not its own length:
+    // F filters the particle-scale (zero-energy) noise that the pair lengths carry, twice the
+    // continuum's strain next to the grips (see the top). Both copies of a pair see the same
+    // strain bit for bit, so they break together; each particle writes only its own copies.
+    int count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        const double si = 1.0 + expansion_ * thetaAt(i);
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
+            breaking_[k] = 0;
+            if (!pairs_.alive[k]) continue;
+            const int j = neighbours_[k];
+            const double thetaBar = 0.5 * (thetaAt(i) + thetaAt(j));
+            const Eigen::Vector2d d = (rest_[j] - rest_[i]).head<2>() / pairs_.restLength[k];
+            const double sj = 1.0 + expansion_ * thetaAt(j);
+            const double eta =
+                (0.5 * (deformation_[i] / si + deformation_[j] / sj) * d).norm() - 1.0;
+            const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar);
+            const double length = (x[j] - x[i]).norm() / pairs_.restLength[k];
+            breaking_[k] = eta > limit || length > kTetherStretch;
+            count += breaking_[k];
+        }
+    }
+    std::vector<std::array<int, 2>> apart;
+    if (count == 0) return apart;
+    std::vector<int> touched;
+    for (int i = 0; i < n; ++i)
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
+            if (breaking_[k]) {
+                breakPair(k, touched);
+                if (latticeEdge_[k] && i < neighbours_[k]) apart.push_back({i, neighbours_[k]});
+            }
+    settle(touched);
+    for (int i : touched) deformation_[i] = deformationGradient(i, x);
+    return apart;
+}
+
+bool TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
+    // Without fracture the notches did it all at set-up, with their pairs re-corrected.
+    if (!std::isfinite(criticalStrain_)) return true;
+    std::vector<int> touched;
+    for (const auto& [i, j] : edges)
+        if (const int k = findBond(pairs_, i, j); k >= 0 && pairs_.alive[k]) {
+            breakPair(k, touched);
+            breakPair(mirror_[k], touched);
+        }
+    settle(touched);
+    return true;
+}
+
+void TotalLagrangianSph::breakPair(int k, std::vector<int>& touched) {
+    pairs_.alive[k] = 0;
+    gradient_[k].setZero();
+    const int i = int(std::upper_bound(offsets_.begin(), offsets_.end(), k) - offsets_.begin()) - 1;
+    touched.push_back(i);
+    if (i < neighbours_[k]) ++brokenPairs_;
+}
+
+void TotalLagrangianSph::settle(std::vector<int>& touched) {
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (int i : touched) {
+        // The rest correction A_i^-T stays; i now measures strain against its rest metric
+        // C0 = B^T B, B = sum over its living pairs of d g^T, so the rest state holds no stress.
+        Eigen::Matrix2d B = Eigen::Matrix2d::Zero();
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
+            B += (rest_[neighbours_[k]] - rest_[i]).head<2>() * gradient_[k].transpose();
+        if (restMetric_[i] < 0) {
+            restMetric_[i] = int(metric_.size());
+            metric_.emplace_back();
+        }
+        metric_[restMetric_[i]] = B.transpose() * B;
+    }
+    for (std::size_t t = 0; t < triangleSidePairs_.size(); ++t)
+        for (int k : triangleSidePairs_[t])
+            if (k >= 0 && !pairs_.alive[k]) triangleAlive_[t] = 0;
+}
+
+std::vector<std::array<int, 2>> TotalLagrangianSph::advance(const std::vector<Eigen::Vector3d>& x,
+                                                            const std::vector<Eigen::Vector3d>&,
+                                                            double,
+                                                            std::vector<Eigen::Vector3d>& force) {
+    if (!std::isfinite(criticalStrain_)) {
+        forces(x, force);
+        return {};
+    }
+    std::vector<std::array<int, 2>> apart = fracture(x);  // leaves deformation_ at x
+    forcesFrom(force);
+    return apart;
+}
+
+void TotalLagrangianSph::deformations(const std::vector<Eigen::Vector3d>& x) const {
+    const int n = int(x.size());
+    deformation_.resize(n);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) deformation_[i] = deformationGradient(i, x);
 }
 
 void TotalLagrangianSph::correctGradients(int i) {
@@ -75,21 +215,31 @@ Eigen::Matrix<double, 3, 2> TotalLagrangianSph::deformationGradient(
     return F;
 }
 
+Eigen::Matrix2d TotalLagrangianSph::greenStrain(int i, const Eigen::Matrix<double, 3, 2>& F) const {
+    if (restMetric_[i] < 0) return 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+    return 0.5 * (F.transpose() * F - metric_[restMetric_[i]]);
+}
+
 Eigen::Matrix<double, 3, 2> TotalLagrangianSph::firstPiola(
-    const Eigen::Matrix<double, 3, 2>& F) const {
-    const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+    int i, const Eigen::Matrix<double, 3, 2>& F) const {
+    const Eigen::Matrix2d E = greenStrain(i, F);
     return F * (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
 }
 
 void TotalLagrangianSph::forces(const std::vector<Eigen::Vector3d>& x,
                                 std::vector<Eigen::Vector3d>& force) const {
-    const int n = int(x.size());
+    deformations(x);
+    forcesFrom(force);
+}
+
+void TotalLagrangianSph::forcesFrom(std::vector<Eigen::Vector3d>& force) const {
+    const int n = int(deformation_.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
         const double stretch = 1.0 + expansion_ * thetaAt(i);
         stress_[i] = volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) /
-                     stretch * firstPiola(deformationGradient(i, x) / stretch);
+                     stretch * firstPiola(i, deformation_[i] / stretch);
     }
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
@@ -129,7 +279,7 @@ double TotalLagrangianSph::strainEnergy(const std::vector<Eigen::Vector3d>& x) c
     for (int i = 0; i < int(x.size()); ++i) {
         const Eigen::Matrix<double, 3, 2> F =
             deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(i));
-        const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
+        const Eigen::Matrix2d E = greenStrain(i, F);
         sum += volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }

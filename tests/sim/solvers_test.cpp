@@ -442,7 +442,7 @@ TEST(Solvers, OneAndTwoThreadsGiveIdenticalBitsWithEverySolver) {
     for (SolverKind s : kSolvers) {
         MembraneParams p = sheet(s, 0.3, 1.0, 1.0);
         p.sheet.perturbationAmplitude = 1e-4;
-        if (s != SolverKind::Sph) p.material.fractureEnergy = 0.02;
+        p.material.fractureEnergy = 0.02;
         BoundaryCondition left, right;
         left.kind = right.kind = BoundaryKind::Velocity;
         left.region.max.x() = -0.49;

@@ -804,10 +804,9 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
-    // Every solver takes notches and the coupling to theta, all but the SPH fracture and the
+    // Every solver takes notches, fracture and the coupling to theta, and all but the SPH the
     // three bond laws.
     const bool sph = p.solver == sim::SolverKind::Sph;
-    if (m.fractureEnergy && sph) wanted.push_back("fracture (material.fracture_energy)");
     if (m.law != sim::BondLawKind::Linear && sph) wanted.push_back("a bond law other than linear");
     if (m.criticalStretch == sim::CriticalStretchMode::Paper)
         wanted.push_back("critical_stretch = \"paper\"");
@@ -819,11 +818,11 @@ void readSolver(const TableReader& root, sim::MembraneParams& p) {
     for (std::size_t k = 0; k < wanted.size(); ++k)
         needs += (k == 0 ? "" : k + 1 == wanted.size() ? " and " : ", ") + wanted[k];
     if (needs.empty()) return;
-    root.fail(kSolver.key, "\"peridynamic\" for a scene with " + needs,
-              "\"" + std::string(kSolvers[std::size_t(p.solver)]) + "\"",
-              "Only the peridynamic solver has " + needs +
-                  " so far; remove it or use "
-                  "solver = \"peridynamic\".");
+    const std::string solver(kSolvers[std::size_t(p.solver)]);
+    root.fail(kSolver.key, "a solver that takes " + needs, "\"" + solver + "\"",
+              "The " + solver + " solver does not take " + needs +
+                  "; remove it or use solver = \"peridynamic\" (README \"Solvers\" lists what "
+                  "each takes).");
 }
 
 std::string toJson(const toml::table& document) {

@@ -95,8 +95,10 @@ for solver in fem_cst mass_spring_tp; do  # the foil's elastoplastic law and the
             --set solver=$solver --renderer none --out "$tmp/$scene-$solver"
     done
 done
+check "a notched, breaking scene runs with sph" run 0 run scenes/crack_path_sources.toml \
+    --set time.duration=0.3 --set solver=sph --renderer none --out "$tmp/sph-crack"
 check "sph refuses a sphere" run 2 run scenes/pressurised_sphere.toml --set solver=sph --out "$tmp/sphsphere"
-check "sph refusal names the solver" grep -q "solver: expected \"peridynamic\"" "$tmp/stderr"
+check "sph refusal names the solver" grep -q "solver: expected a solver that takes shape" "$tmp/stderr"
 check "sph refusal leaves no output" test ! -e "$tmp/sphsphere"
 
 # Skipping: --renderer none with no export builds no surface, and the simulation is bitwise the

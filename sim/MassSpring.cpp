@@ -81,6 +81,7 @@ void MassSpring::breakSpring(int s) {
 
 std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
     std::vector<std::array<int, 2>> apart;
+    if (plastic_.empty() && !std::isfinite(criticalStrain_)) return apart;  // nothing to record
     for (int s = 0; s < int(springs_.size()); ++s) {
         if (!springAlive_[s]) continue;
         double thetaBar;

@@ -17,6 +17,7 @@
 #include "sim/MassSpring.h"
 #include "sim/Membrane.h"
 #include "sim/Random.h"
+#include "tests/sim/ThreadCheck.h"
 
 using namespace rend::sim;
 
@@ -335,29 +336,9 @@ TEST(SpringLaws, OneAndTwoThreadsGiveIdenticalBitsWithEveryLaw) {
             p.material.fractureEnergy = 0.05;  // breaks at 1.2%
             p.material.yieldStrain = 0.005;
             p.notches = {Notch{{{-0.25, 0.0085}, {0.0, 0.0085}}}};
-            BoundaryCondition left, right;
-            left.kind = right.kind = BoundaryKind::Velocity;
-            left.region.max.x() = -0.49;
-            right.region.min.x() = 0.49;
-            left.velocity = {-0.3, 0, 0.02};
-            right.velocity = {0.3, 0, 0};
-            p.boundaries = {left, right};
-            auto run = [&](int threads) {
-                omp_set_num_threads(threads);
-                Membrane m(p);
-                EXPECT_GT(m.particleCount(), kParallelThreshold) << "must take the parallel path";
-                for (int k = 0; k < 200; ++k) m.step();
-                m.updateDamage();
-                return std::tuple{m.positions(), m.brokenBondCount(), m.damage()};
-            };
-            const auto [one, brokenOne, damageOne] = run(1);
-            const auto [two, brokenTwo, damageTwo] = run(2);
-            omp_set_num_threads(2);
-            ASSERT_EQ(one.size(), two.size());
-            EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(one[0])), 0);
-            EXPECT_EQ(brokenOne, brokenTwo);
-            EXPECT_EQ(damageOne, damageTwo);
+            p.boundaries = support::pullingGrips();
+            const std::size_t broken = support::expectSameBitsWithOneAndTwoThreads(p, 200);
             std::printf("%d law %d: %zu broken bonds with 1 and 2 threads\n", int(solver),
-                        int(law.law), brokenOne);
+                        int(law.law), broken);
         }
 }

@@ -133,6 +133,7 @@ FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double th
     for (const Element& e : elements_) kept.push_back(e.v);
     triangleIncidence(kept, int(p.size()), cornerOffsets_, corners_);
     cornerForce_.resize(3 * elements_.size());
+    eroding_.assign(elements_.size(), 0);
     if (law_.kind == BondLawKind::Elastoplastic) {
         plasticStrain_.assign(elements_.size(), Eigen::Matrix2d::Zero());
         maxStrain_.assign(elements_.size(), 0.0);
@@ -166,13 +167,16 @@ Eigen::Matrix2d FemCst::greenStrain(int t, const std::vector<Eigen::Vector3d>& x
 
 void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
                     std::vector<Eigen::Vector3d>& force) const {
-    elementForces(x, force, nullptr, 0.0);
+    // With kAdvance = false the pass writes nothing but the forces (and its scratch corners).
+    const_cast<FemCst*>(this)->elementPass<false>(x, force, nullptr, 0.0);
 }
 
-double FemCst::elementForces(const std::vector<Eigen::Vector3d>& x,
-                             std::vector<Eigen::Vector3d>& force,
-                             const std::vector<Eigen::Vector3d>* v, double dt) const {
+template <bool kAdvance>
+double FemCst::elementPass(const std::vector<Eigen::Vector3d>& x,
+                           std::vector<Eigen::Vector3d>& force,
+                           const std::vector<Eigen::Vector3d>* v, double dt) {
     const int elements = int(elements_.size());
+    const bool breakable = std::isfinite(criticalStrain_);
     double lowest = 0.0;
 #pragma omp parallel for schedule(static) reduction(min \
                                                     : lowest) if (elements >= kParallelThreshold)
@@ -187,8 +191,20 @@ double FemCst::elementForces(const std::vector<Eigen::Vector3d>& x,
         // Psi(F / s), whose derivative is P(F / s) / s.
         const double theta = thetaOf(e), stretch = 1.0 + expansion_ * theta;
         const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x) / stretch;
+        const bool linear = law_.kind == BondLawKind::Linear;
+        Stretches principal;  // the non-linear laws': one decomposition for yield and stress
+        if (!linear) principal = stretchesOf(F);
+        if constexpr (kAdvance) {
+            if (!maxStrain_.empty()) yieldElement(t, principal);  // eq. 20, this element's own
+            if (breakable && pastCriticalStrain(t, x)) {
+                eroding_[t] = 1;
+                cornerForce_[3 * t] = cornerForce_[3 * t + 1] = cornerForce_[3 * t + 2] =
+                    Eigen::Vector3d::Zero();
+                continue;
+            }
+        }
         Eigen::Matrix2d S;
-        if (law_.kind == BondLawKind::Linear) {
+        if (linear) {
             const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
             S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
                 (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
@@ -197,7 +213,7 @@ double FemCst::elementForces(const std::vector<Eigen::Vector3d>& x,
             Eigen::Matrix<double, 3, 2> rate;
             if (ahead) rate = deformationGradient(e, *v) / stretch;
             S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
-                nonlinearStress(t, F, nullptr, ahead ? &rate : nullptr, dt,
+                nonlinearStress(t, F, principal, nullptr, ahead ? &rate : nullptr, dt,
                                 ahead ? &lowest : nullptr);
         }
         const Eigen::Matrix<double, 3, 2> H =
@@ -250,13 +266,20 @@ void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
     }
 }
 
-Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+FemCst::Stretches FemCst::stretchesOf(const Eigen::Matrix<double, 3, 2>& F) {
+    const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
+    Stretches p{c.vectors, {}, {}};
+    rend::sim::stretchesOf(c.value, p.stretch, p.strain);
+    return p;
+}
+
+Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F,
+                                        const Stretches& principal, double* energy,
                                         const Eigen::Matrix<double, 3, 2>* rate, double dt,
                                         double* lowest) const {
-    const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
-    Eigen::Vector2d l, e;
-    stretchesOf(c.value, l, e);
-    const Eigen::Matrix2d& V = c.vectors;
+    const Eigen::Vector2d& l = principal.stretch;
+    const Eigen::Vector2d& e = principal.strain;
+    const Eigen::Matrix2d& V = principal.directions;
     if (lowest) {  // where each principal strain will be in dt if it keeps closing
         for (int k = 0; k < 2; ++k) {
             // dl/dt = (F n) . (dF/dt n) / l along the principal direction n.
@@ -288,12 +311,9 @@ Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>
     return V * S * V.transpose();
 }
 
-void FemCst::yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F) {
-    const Principal c = principal(0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity()));
-    Eigen::Vector2d l, e;
-    stretchesOf(c.value, l, e);
-    const Principal elastic =
-        principal(c.vectors * e.asDiagonal() * c.vectors.transpose() - plasticStrain_[t]);
+void FemCst::yieldElement(int t, const Stretches& p) {
+    const Principal elastic = principal(
+        p.directions * p.strain.asDiagonal() * p.directions.transpose() - plasticStrain_[t]);
     // The total strain along the most stretched elastic direction, the bond's eta of eq. 20.
     const double before = law_.plasticStrain({maxStrain_[t]});
     const double trial = elastic.value[0] + before;
@@ -306,32 +326,42 @@ void FemCst::yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F) {
     }
 }
 
+bool FemCst::pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) const {
+    // Largest principal Green strain of the mechanical part against the critical stretch's,
+    // (l^2 - 1) / 2, with l = 1 + eps_c weakened by theta.
+    const double theta = thetaOf(elements_[t]);
+    const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * theta);
+    const double stretch = 1.0 + expansion_ * theta;
+    const Eigen::Matrix2d E =
+        0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
+               Eigen::Matrix2d::Identity());
+    const double centre = 0.5 * E.trace();
+    const double radius = std::hypot(0.5 * (E(0, 0) - E(1, 1)), E(0, 1));
+    return centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1);
+}
+
+void FemCst::erodeFlagged(std::vector<std::array<int, 2>>& apart) {
+    for (int t = 0; t < int(elements_.size()); ++t)
+        if (eroding_[t]) {
+            eroding_[t] = 0;
+            erode(t, apart);
+        }
+}
+
 std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
     std::vector<std::array<int, 2>> apart;
-    if (!maxStrain_.empty()) {  // eq. 20's history, per element, independent of the others
-        const int elements = int(elements_.size());
+    const bool breakable = std::isfinite(criticalStrain_);
+    if (maxStrain_.empty() && !breakable) return apart;
+    const int elements = int(elements_.size());
 #pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
-        for (int t = 0; t < elements; ++t) {
-            if (!alive_[t]) continue;
-            const double stretch = 1.0 + expansion_ * thetaOf(elements_[t]);
-            yieldElement(t, deformationGradient(elements_[t], x) / stretch);
-        }
-    }
-    if (!std::isfinite(criticalStrain_)) return apart;
-    for (int t = 0; t < int(elements_.size()); ++t) {
+    for (int t = 0; t < elements; ++t) {  // each element's own history and flag
         if (!alive_[t]) continue;
-        // Largest principal Green strain of the mechanical part against the critical
-        // stretch's, (l^2 - 1) / 2, with l = 1 + eps_c weakened by theta.
-        const double theta = thetaOf(elements_[t]);
-        const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * theta);
-        const double stretch = 1.0 + expansion_ * theta;
-        const Eigen::Matrix2d E =
-            0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
-                   Eigen::Matrix2d::Identity());
-        const double centre = 0.5 * E.trace();
-        const double radius = std::hypot(0.5 * (E(0, 0) - E(1, 1)), E(0, 1));
-        if (centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1)) erode(t, apart);
+        const double stretch = 1.0 + expansion_ * thetaOf(elements_[t]);
+        if (!maxStrain_.empty())
+            yieldElement(t, stretchesOf(deformationGradient(elements_[t], x) / stretch));
+        if (breakable && pastCriticalStrain(t, x)) eroding_[t] = 1;
     }
+    erodeFlagged(apart);
     return apart;
 }
 
@@ -355,10 +385,12 @@ double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
             0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
                    Eigen::Matrix2d::Identity());
         double density;
-        if (law_.kind == BondLawKind::Linear)
+        if (law_.kind == BondLawKind::Linear) {
             density = 0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum();
-        else
-            nonlinearStress(t, deformationGradient(elements_[t], x) / stretch, &density);
+        } else {
+            const Eigen::Matrix<double, 3, 2> F = deformationGradient(elements_[t], x) / stretch;
+            nonlinearStress(t, F, stretchesOf(F), &density);
+        }
         sum += elements_[t].restArea * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
                density;
     }
@@ -368,8 +400,9 @@ double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
 std::vector<std::array<int, 2>> FemCst::advance(const std::vector<Eigen::Vector3d>& x,
                                                 const std::vector<Eigen::Vector3d>& v, double dt,
                                                 std::vector<Eigen::Vector3d>& force) {
-    std::vector<std::array<int, 2>> apart = fracture(x);
-    const double lowest = elementForces(x, force, &v, dt);
+    std::vector<std::array<int, 2>> apart;
+    const double lowest = elementPass<true>(x, force, &v, dt);
+    erodeFlagged(apart);
     // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
     stiffening_ = law_.kind == BondLawKind::PowerLaw
                       ? std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)))

@@ -101,21 +101,39 @@ private:
     /// `energy` when asked.
     /// With `lowest`, also lowers it to the smallest principal Biot strain, looked ahead by dt
     /// at the rate dF/dt = `rate` (when given).
-    Eigen::Matrix2d nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F, double* energy,
+    /// Principal directions V of C = F^T F (columns, largest first), stretches l_k and Biot
+    /// strains e_k = l_k - 1.
+    struct Stretches {
+        Eigen::Matrix2d directions;
+        Eigen::Vector2d stretch, strain;
+    };
+    static Stretches stretchesOf(const Eigen::Matrix<double, 3, 2>& F);
+    Eigen::Matrix2d nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>& F,
+                                    const Stretches& principal, double* energy,
                                     const Eigen::Matrix<double, 3, 2>* rate = nullptr,
                                     double dt = 0.0, double* lowest = nullptr) const;
-    /// forces(), with velocities v for the power law's look-ahead; returns the smallest
-    /// principal Biot strain (0 when none is compressed; linear law: 0).
-    double elementForces(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& force,
-                         const std::vector<Eigen::Vector3d>* v, double dt) const;
+    /// One parallel pass over the elements, then the gather into `force`. With kAdvance (a
+    /// step's advance()) it also yields elastoplastic elements and flags in `eroding_` those
+    /// past the critical strain, which carry nothing from this step on; without, it writes
+    /// nothing but the forces. Velocities v give the power law's look-ahead. Returns the
+    /// smallest principal Biot strain (0 when none is compressed; linear law: 0).
+    template <bool kAdvance>
+    double elementPass(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& force,
+                       const std::vector<Eigen::Vector3d>* v, double dt);
     /// Elastoplastic history step of element t at the mechanical deformation F.
-    void yieldElement(int t, const Eigen::Matrix<double, 3, 2>& F);
+    void yieldElement(int t, const Stretches& principal);
+    /// Whether element t is past the critical strain at x: its largest principal Green strain
+    /// of the mechanical part against the critical stretch's, both weakened by theta.
+    bool pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
+    /// Removes the flagged elements in index order (so the sides reported do not depend on
+    /// the thread count) and clears the flags.
+    void erodeFlagged(std::vector<std::array<int, 2>>& apart);
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each
     // particle sums its own forces and the loop needs no atomics (and no ordering by thread).
     std::vector<int> cornerOffsets_, corners_;
-    mutable std::vector<Eigen::Vector3d> cornerForce_;
+    std::vector<Eigen::Vector3d> cornerForce_;
     double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0, criticalStrain_ = 0.0;
     double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
     BondLaw law_;  ///< the material's law at unit stiffness (c = 1): its shape f/c
@@ -123,6 +141,7 @@ private:
     std::vector<Eigen::Matrix2d> plasticStrain_;
     std::vector<double> maxStrain_;
     double stiffening_ = 1.0;
+    std::vector<std::uint8_t> eroding_;  ///< per element: past the critical strain this step
     // bindBonds: per bond, its ends and the elements holding it as a side (-1: none).
     std::vector<std::array<int, 2>> bondEnds_, bondElements_;
     std::vector<std::uint8_t> alive_;          ///< per element

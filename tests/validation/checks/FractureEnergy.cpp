@@ -40,22 +40,24 @@ void holdFarEnd(MembraneParams& p, const std::vector<double>& rows, double strai
     }
 }
 
-/// The strip's Griffith strain: E' eps^2 H / 2 = G_f, E' = E / (1 - nu^2) as the grips hold x.
-double stripGriffithStrain(const NotchedStrip& s, double height) {
+}  // namespace
+
+double stripGriffithStrain(const NotchedStrip& s, const MembraneParams& p) {
+    const double height = 2.0 * p.boundaries[0].region.min.y();  // between the grip rows
     return std::sqrt(2.0 * s.fractureEnergy / (s.youngsModulus / (1.0 - 1.0 / 9.0) * height));
 }
 
-}  // namespace
-
 MembraneParams pulledStrip(const NotchedStrip& s) {
     MembraneParams p;
+    p.solver = s.solver;
+    if (s.solver != SolverKind::Peridynamic) p.material.poissonRatio = 1.0 / 3.0;
     p.sheet.size = {s.width, s.height};
     p.sheet.dx = s.dx;
     p.sheet.horizonFactor = s.horizonFactor;
     p.sheet.thickness = s.thickness;
     p.material.youngsModulus = s.youngsModulus;
     p.material.density = s.density;
-    p.material.fractureEnergy = s.fractureEnergy;
+    p.material.fractureEnergy = s.fractureEnergy * s.criticalStrainScale * s.criticalStrainScale;
     p.material.criticalStretch = s.mode;
     const std::vector<double> rows = rowHeights(p);
     const auto above = std::upper_bound(rows.begin(), rows.end(), 0.0);
@@ -71,6 +73,7 @@ MembraneParams pulledStrip(const NotchedStrip& s) {
     p.boundaries = {top, bottom};
     if (s.holdFarEnd) holdFarEnd(p, rows, s.strainRate);
     p.damping = s.damping;
+    p.time.safety = s.timeStepSafety;
     return p;
 }
 
@@ -78,7 +81,7 @@ CrackRecord runCrack(const NotchedStrip& s, double windowStart, double windowEnd
     const MembraneParams p = pulledStrip(s);
     const double y = p.notches[0].points[0].y();
     const double height = 2.0 * p.boundaries[0].region.min.y();  // between the grip rows
-    const double griffith = stripGriffithStrain(s, height);
+    const double griffith = stripGriffithStrain(s, p);
     Membrane m(p);
     const double prestretch = 0.8 * griffith;
     for (auto& x : m.positions()) x.y() *= 1.0 + prestretch;

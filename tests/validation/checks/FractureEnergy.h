@@ -26,6 +26,9 @@ namespace rend::checks {
 /// A 1.2 m x 0.3 m strip, notched from the left edge along the line between the two rows next
 /// to y = 0 up to x = -0.25 m (0.35 m, longer than the strip is high).
 struct NotchedStrip {
+    /// Any solver; the others than the peridynamic bonds get nu = 1/3, the bonds' own, so the
+    /// strip's Griffith strain is the same for all (checks/CrackRelease.h books them).
+    sim::SolverKind solver = sim::SolverKind::Peridynamic;
     sim::CriticalStretchMode mode = sim::CriticalStretchMode::Calibrated;
     double dx = 0.01;  ///< m
     double horizonFactor = 1.5;
@@ -35,9 +38,14 @@ struct NotchedStrip {
     double fractureEnergy = 0.5;  ///< J/m^2: eta_c = 0.051 (calibrated, R = 1.5 dx)
     double width = 1.2, height = 0.3;
     double notchTip = -0.25;
-    double strainRate = 0.01;  ///< 1/s, after the pre-stretch
-    double damping = 60.0;     ///< 1/s
-    double duration = 6.0;     ///< s, simulated, at most
+    double strainRate = 0.01;     ///< 1/s, after the pre-stretch
+    double damping = 60.0;        ///< 1/s
+    double duration = 6.0;        ///< s, simulated, at most
+    double timeStepSafety = 0.8;  ///< dt over the stable bound (TimeParams::safety)
+    /// Tries a recalibration without touching the solver: its critical strain, proportional to
+    /// sqrt(G_f) in every solver, is scaled by this, the material getting G_f scale^2, while the
+    /// booking and the Griffith strain keep fractureEnergy.
+    double criticalStrainScale = 1.0;
     /// Hold the far (right) end in the strip's uniform plane-strain state. Left free, the
     /// corners where it meets the grips concentrate stress and break (the `elsewhere` bonds): at
     /// dx = 0.01, 58 bonds at R = 2 dx while the crack runs, and at R = 3 dx 1592, starting
@@ -62,6 +70,10 @@ struct CrackRecord {
 };
 
 sim::MembraneParams pulledStrip(const NotchedStrip& s);
+
+/// The strip's Griffith strain, E' eps^2 H / 2 = G_f with E' = E / (1 - nu^2), nu = 1/3 (the
+/// grips hold x), H the distance between the grip rows of `p` = pulledStrip(s).
+double stripGriffithStrain(const NotchedStrip& s, const sim::MembraneParams& p);
 
 /// Pulls the strip until the crack front passes `windowEnd`, booking every bond as it breaks;
 /// the window [windowStart, windowEnd) books its own energy too.

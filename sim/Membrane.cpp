@@ -73,17 +73,26 @@ double springCriticalStrain(const MembraneParams& params) {
                      (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
 }
 
+double bandCriticalStrain(const MembraneParams& params) {
+    // An eroded element (or a two-parameter triangle with a broken side) releases only its own
+    // energy: the band the crack takes out, sqrt(3)/2 dx high, at E eps^2 / (2 (1 - nu^2)),
+    // holds G_f h per unit length at sqrt(2 (1 - nu^2)) times the springs' strain.
+    const double nu = params.material.poissonRatio;
+    return std::sqrt(2.0 * (1.0 - nu * nu)) * springCriticalStrain(params);
+}
+
 std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
     const MaterialParams& m = params.material;
     const double h = params.sheet.thickness;
     const double critical = springCriticalStrain(params);
     switch (params.solver) {
         case SolverKind::FemCst:
-            return std::make_unique<FemCst>(lattice, m, h, critical);
+            return std::make_unique<FemCst>(lattice, m, h, bandCriticalStrain(params));
         case SolverKind::MassSpringVanGelder:
             return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
         case SolverKind::MassSpringTwoParameter:
-            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h, critical);
+            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h,
+                                                bandCriticalStrain(params));
         case SolverKind::Sph:
             if (params.sheet.outline == Outline::Sphere)
                 throw std::invalid_argument("the sph solver needs a flat rest sheet");

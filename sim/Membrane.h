@@ -41,6 +41,10 @@ public:
 /// lattice row store the fracture energy G_f (infinity without one).
 double springCriticalStrain(const MembraneParams& params);
 
+/// Critical strain of the FEM elements and the two-parameter springs, whose cracks take out a
+/// band of elements (triangles) one row high: sqrt(2 (1 - nu^2)) times the springs'.
+double bandCriticalStrain(const MembraneParams& params);
+
 class PeridynamicBonds;
 
 /// The Solver a scene's `solver` names, for the solvers that do not use the Membrane's bonds

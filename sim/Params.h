@@ -160,6 +160,13 @@ struct TimeParams {
 /// membrane paper's SPH comparison (Sec. 6.1), total-Lagrangian and kernel-corrected.
 enum class SolverKind { Peridynamic, FemCst, MassSpringVanGelder, MassSpringTwoParameter, Sph };
 
+/// The name a scene's `solver` key gives each solver.
+inline const char* solverName(SolverKind kind) {
+    constexpr const char* kNames[] = {"peridynamic", "fem_cst", "mass_spring_vg", "mass_spring_tp",
+                                      "sph"};
+    return kNames[int(kind)];
+}
+
 struct MembraneParams {
     SolverKind solver = SolverKind::Peridynamic;
     SheetParams sheet;

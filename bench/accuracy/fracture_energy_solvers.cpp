@@ -51,10 +51,8 @@ void fractureEnergySolversCase(Report& report) {
     for (SolverKind solver :
          {SolverKind::Peridynamic, SolverKind::FemCst, SolverKind::MassSpringVanGelder,
           SolverKind::MassSpringTwoParameter, SolverKind::Sph}) {
-        Family f{"fracture_energy_solvers",
-                 std::string(checks::solverName(solver)) + " dt sweep",
-                 {},
-                 ""};
+        Family f{
+            "fracture_energy_solvers", std::string(sim::solverName(solver)) + " dt sweep", {}, ""};
         std::string measured;
         // SPH gives no single crack at any dt and takes 40 s at 0.2 x the bound.
         const int count = solver == SolverKind::Sph ? 1 : 3;
@@ -63,7 +61,7 @@ void fractureEnergySolversCase(Report& report) {
             f.points.push_back(
                 {"dt=" + fmt("%.1f", safeties[k]), p.seconds, std::abs(p.ratio - 1.0)});
             report.row(f, f.points.back());
-            report.line(tableRow(checks::solverName(solver), safeties[k], p));
+            report.line(tableRow(sim::solverName(solver), safeties[k], p));
             measured += (measured.empty() ? "" : ", ") + fmt("%.4f", p.ratio);
         }
         f.why =

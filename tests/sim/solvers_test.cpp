@@ -26,22 +26,6 @@ constexpr SolverKind kSolvers[] = {SolverKind::Peridynamic, SolverKind::FemCst,
                                    SolverKind::MassSpringVanGelder,
                                    SolverKind::MassSpringTwoParameter, SolverKind::Sph};
 
-const char* nameOf(SolverKind s) {
-    switch (s) {
-        case SolverKind::FemCst:
-            return "fem_cst";
-        case SolverKind::MassSpringVanGelder:
-            return "mass_spring_vg";
-        case SolverKind::MassSpringTwoParameter:
-            return "mass_spring_tp";
-        case SolverKind::Sph:
-            return "sph";
-        case SolverKind::Peridynamic:
-            break;
-    }
-    return "peridynamic";
-}
-
 MembraneParams sheet(SolverKind solver, double nu, double width = 0.4, double height = 0.4) {
     MembraneParams p;
     p.solver = solver;
@@ -81,15 +65,15 @@ TEST(Solvers, RigidMotionGivesZeroForce) {
         double worst = 0.0;
         for (int i = 0; i < m.particleCount(); ++i)
             worst = std::max(worst, (after[i] - R * before[i]).norm());
-        EXPECT_LT(worst, 1e-10 * maxNorm(before)) << nameOf(s) << ": forces turn with the body";
+        EXPECT_LT(worst, 1e-10 * maxNorm(before)) << solverName(s) << ": forces turn with the body";
 
         for (int i = 0; i < m.particleCount(); ++i) m.positions()[i] = m.restPositions()[i];
         for (auto& x : m.positions()) x = R * x + Eigen::Vector3d(0.3, -1.0, 2.0);
         m.computeForces(after);
-        EXPECT_LT(maxNorm(after), 1e-12 * maxNorm(before) * 1e3) << nameOf(s) << " at rest";
+        EXPECT_LT(maxNorm(after), 1e-12 * maxNorm(before) * 1e3) << solverName(s) << " at rest";
         Eigen::Vector3d total = Eigen::Vector3d::Zero();
         for (const auto& f : before) total += f;
-        EXPECT_LT(total.norm(), 1e-12 * maxNorm(before) * m.particleCount()) << nameOf(s);
+        EXPECT_LT(total.norm(), 1e-12 * maxNorm(before) * m.particleCount()) << solverName(s);
     }
 }
 
@@ -127,7 +111,7 @@ TEST(Solvers, BondFemAndSphForcesAreMinusTheGradientOfTheStrainEnergy) {
                 m.positions()[i][a] = keep;
                 worst = std::max(worst, std::abs(-(up - down) / (2 * h) - f[i][a]));
             }
-        EXPECT_LT(worst, 1e-6 * maxNorm(f)) << nameOf(s) << " law " << int(law);
+        EXPECT_LT(worst, 1e-6 * maxNorm(f)) << solverName(s) << " law " << int(law);
     }
 }
 
@@ -225,10 +209,10 @@ TEST(Solvers, UniaxialStressPatchIsInEquilibriumAndCarriesE) {
         std::printf(
             "%-15s nu = %.3f: right half's force / (E e h H) = %.6f, largest inner force / it "
             "= %.2e\n",
-            nameOf(c.solver), c.nu, -right / expected, inside / expected);
+            solverName(c.solver), c.nu, -right / expected, inside / expected);
         if (c.exact) {
-            EXPECT_NEAR(-right / expected, 1.0, 1e-5) << nameOf(c.solver) << " " << c.nu;
-            EXPECT_LT(inside / expected, 1e-5) << nameOf(c.solver) << " " << c.nu;
+            EXPECT_NEAR(-right / expected, 1.0, 1e-5) << solverName(c.solver) << " " << c.nu;
+            EXPECT_LT(inside / expected, 1e-5) << solverName(c.solver) << " " << c.nu;
         }
         if (c.solver == SolverKind::Sph) {
             const double cells = (yMax - yMin + dx * std::sqrt(3.0) / 2) / (yMax - yMin);
@@ -268,9 +252,10 @@ TEST(Solvers, StableStepBoundsTheHighestFrequency) {
             for (auto& x : v) x /= size;
         }
         const double omegaDt = std::sqrt(lambda) * m.stableTimeStep();
-        std::printf("%-15s omega_max * stable dt = %.3f (stable below 2)\n", nameOf(s), omegaDt);
-        EXPECT_LE(omegaDt, 2.0) << nameOf(s);
-        EXPECT_GT(omegaDt, 0.5) << nameOf(s) << ": the bound is needlessly small";
+        std::printf("%-15s omega_max * stable dt = %.3f (stable below 2)\n", solverName(s),
+                    omegaDt);
+        EXPECT_LE(omegaDt, 2.0) << solverName(s);
+        EXPECT_GT(omegaDt, 0.5) << solverName(s) << ": the bound is needlessly small";
     }
 }
 
@@ -289,11 +274,11 @@ TEST(Solvers, EverySolverRunsAStretchWithTheSameBoundariesAndStaysFinite) {
         for (int k = 0; k < 2000; ++k) m.step();
         double xMax = -1e9;
         for (const auto& x : m.positions()) {
-            ASSERT_TRUE(x.allFinite()) << nameOf(s);
+            ASSERT_TRUE(x.allFinite()) << solverName(s);
             xMax = std::max(xMax, x.x());
         }
-        EXPECT_NEAR(xMax, 0.2 + 0.02 * m.time(), 1e-9) << nameOf(s) << ": the grip moved";
-        EXPECT_GT(m.strainEnergy(), 0.0) << nameOf(s);
+        EXPECT_NEAR(xMax, 0.2 + 0.02 * m.time(), 1e-9) << solverName(s) << ": the grip moved";
+        EXPECT_GT(m.strainEnergy(), 0.0) << solverName(s);
     }
 }
 
@@ -317,21 +302,21 @@ TEST(Solvers, SpringsAndElementsBreakPastTheCriticalStrainAndNeverHeal) {
             m.step();
             const std::size_t broken = m.brokenBondCount();
             if (factor < 1) {
-                EXPECT_EQ(broken, 0u) << nameOf(s);
+                EXPECT_EQ(broken, 0u) << solverName(s);
                 continue;
             }
-            EXPECT_EQ(broken, m.bondCount()) << nameOf(s) << ": every edge came apart";
+            EXPECT_EQ(broken, m.bondCount()) << solverName(s) << ": every edge came apart";
             for (int i = 0; i < m.particleCount(); ++i) m.positions()[i] = m.restPositions()[i];
             for (int k = 0; k < 10; ++k) m.step();
-            EXPECT_EQ(m.brokenBondCount(), broken) << nameOf(s) << ": damage never heals";
+            EXPECT_EQ(m.brokenBondCount(), broken) << solverName(s) << ": damage never heals";
             m.updateDamage();
-            for (double d : m.damage()) EXPECT_DOUBLE_EQ(d, 1.0) << nameOf(s);
+            for (double d : m.damage()) EXPECT_DOUBLE_EQ(d, 1.0) << solverName(s);
             const FrameView v = m.view(1);
             if (s == SolverKind::FemCst) {
                 ASSERT_EQ(v.triangleAlive.size(), m.lattice().triangles.size());
                 for (auto alive : v.triangleAlive) EXPECT_EQ(alive, 0) << "eroded";
             } else {
-                EXPECT_TRUE(v.triangleAlive.empty()) << nameOf(s);
+                EXPECT_TRUE(v.triangleAlive.empty()) << solverName(s);
             }
         }
     }
@@ -347,8 +332,8 @@ TEST(Solvers, SpringsAlongANotchAreCutAndALoadedNotchedSheetTearsFinitely) {
         p.notches = {Notch{{{-0.25, 0.0085}, {0.0, 0.0085}}}};
         Membrane m(p);
         const std::size_t notched = m.brokenBondCount();
-        EXPECT_EQ(notched, m.notchedBondCount()) << nameOf(s);
-        EXPECT_GE(notched, 20u) << nameOf(s) << ": two springs per dx of notch";
+        EXPECT_EQ(notched, m.notchedBondCount()) << solverName(s);
+        EXPECT_GE(notched, 20u) << solverName(s) << ": two springs per dx of notch";
         // Pull the two halves apart rigidly: the cut springs must not pull back.
         for (int i = 0; i < m.particleCount(); ++i) {
             const Eigen::Vector3d& x0 = m.restPositions()[i];
@@ -358,7 +343,7 @@ TEST(Solvers, SpringsAlongANotchAreCutAndALoadedNotchedSheetTearsFinitely) {
         m.computeForces(f);
         for (int i = 0; i < m.particleCount(); ++i) {
             if (m.restPositions()[i].x() < -0.05) {  // far from the tip, across the cut only
-                EXPECT_LT(f[i].norm(), 1e-12) << nameOf(s) << " particle " << i;
+                EXPECT_LT(f[i].norm(), 1e-12) << solverName(s) << " particle " << i;
             }
         }
 
@@ -372,8 +357,8 @@ TEST(Solvers, SpringsAlongANotchAreCutAndALoadedNotchedSheetTearsFinitely) {
         p.damping = 5.0;
         Membrane loaded(p);
         while (loaded.time() < 0.5) loaded.step();
-        EXPECT_GT(loaded.brokenBondCount(), notched) << nameOf(s);
-        for (const auto& x : loaded.positions()) ASSERT_TRUE(x.allFinite()) << nameOf(s);
+        EXPECT_GT(loaded.brokenBondCount(), notched) << solverName(s);
+        for (const auto& x : loaded.positions()) ASSERT_TRUE(x.allFinite()) << solverName(s);
     }
 }
 
@@ -391,7 +376,7 @@ TEST(Solvers, ThermalStrainWithEveryCoupledSolverAndBondLawsWithVanGelder) {
         const double strain = (warm.positions()[b] - warm.positions()[a]).norm() /
                                   (warm.restPositions()[b] - warm.restPositions()[a]).norm() -
                               1.0;
-        EXPECT_NEAR(strain, 0.01, 1e-6) << nameOf(s) << ": free thermal expansion";
+        EXPECT_NEAR(strain, 0.01, 1e-6) << solverName(s) << ": free thermal expansion";
     }
 
     // Elastoplastic springs keep a permanent set once loaded past the yield strain (eq. 20).
@@ -449,9 +434,10 @@ TEST(Solvers, OneAndTwoThreadsGiveIdenticalBitsWithEverySolver) {
         p.sheet.perturbationAmplitude = 1e-4;
         p.material.fractureEnergy = 0.02;
         p.boundaries = support::pullingGrips();
-        SCOPED_TRACE(nameOf(s));
+        SCOPED_TRACE(solverName(s));
         const std::size_t broken = support::expectSameBitsWithOneAndTwoThreads(p, 300);
-        std::printf("%-15s 1 and 2 threads: identical bits, %zu broken bonds\n", nameOf(s), broken);
+        std::printf("%-15s 1 and 2 threads: identical bits, %zu broken bonds\n", solverName(s),
+                    broken);
     }
 }
 

@@ -6,11 +6,11 @@
 // Measured at dx = 0.01 (R = 1.5 dx), far end held, G/G_f at dt = 0.8 / 0.4 / 0.2 x the stable
 // bound (bench_accuracy --only fracture_energy_solvers), onset = grip strain at the first release
 // over the strip's Griffith strain:
-//   pd            1.032 / 0.970 / 0.939   onset 1.82   (row share 0.907 x overshoot)
-//   fem           1.156 / 1.097 / 1.077   onset 1.60   (at the springs' strain 0.637 / 0.619 /
+//   peridynamic   1.032 / 0.970 / 0.939   onset 1.82   (row share 0.907 x overshoot)
+//   fem_cst       1.156 / 1.097 / 1.077   onset 1.60   (at the springs' strain 0.637 / 0.619 /
 //                                                      0.599, onset 1.21: see bandCriticalStrain)
-//   vangelder     1.131 / 1.066 / 1.034   onset 1.90   (row share 1 x overshoot)
-//   twoparameter  1.131 / 1.077 / 1.059   onset 1.65   (springs' strain: 0.645 / 0.623 / 0.606)
+//   mass_spring_vg 1.131 / 1.066 / 1.034   onset 1.90   (row share 1 x overshoot)
+//   mass_spring_tp 1.131 / 1.077 / 1.059   onset 1.65   (springs' strain: 0.645 / 0.623 / 0.606)
 //   sph           no single crack: 50-160 lattice edges break at the grips and most of the
 //                 rest off the notch's line, whatever dt, damping or the far end; onset 2.00.
 // The overshoot: a bond breaks at the first step that finds it past its critical strain, and at

@@ -11,22 +11,6 @@ namespace rend::checks {
 
 using namespace rend::sim;
 
-const char* solverName(SolverKind kind) {
-    switch (kind) {
-        case SolverKind::Peridynamic:
-            return "pd";
-        case SolverKind::FemCst:
-            return "fem";
-        case SolverKind::MassSpringVanGelder:
-            return "vangelder";
-        case SolverKind::MassSpringTwoParameter:
-            return "twoparameter";
-        case SolverKind::Sph:
-            return "sph";
-    }
-    return "?";
-}
-
 ReleaseRecord runCrackRelease(const NotchedStrip& s, double windowStart, double windowEnd) {
     const MembraneParams p = pulledStrip(s);
     const double y = p.notches[0].points[0].y();

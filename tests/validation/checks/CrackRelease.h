@@ -56,7 +56,4 @@ ReleaseRecord runCrackRelease(const NotchedStrip& s, double windowStart, double 
 /// (`window`) only while the front crossed the window, free of the start-up transient.
 double releasedPerLength(const NotchedStrip& s, const ReleaseRecord& r, bool window = false);
 
-/// "pd", "fem", "vangelder", "twoparameter", "sph".
-const char* solverName(sim::SolverKind kind);
-
 }  // namespace rend::checks

@@ -547,14 +547,7 @@ Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays
 
 // ---- Frame set-up ----------------------------------------------------------------------------
 
-void checkGeometry(const Mesh& mesh) {
-    const std::size_t n = mesh.positions.size();
-    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
-        throw std::invalid_argument("EmbreeRenderer: mesh attribute arrays differ in length");
-    for (const auto& t : mesh.triangles)
-        for (std::uint32_t v : t)
-            if (v >= n) throw std::invalid_argument("EmbreeRenderer: triangle index out of range");
-}
+void checkGeometry(const Mesh& mesh) { checkMesh(mesh, "EmbreeRenderer"); }
 
 void checkGeometry(const Splats& splats) {
     const std::size_t n = splats.centers.size();

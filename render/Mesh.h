@@ -2,6 +2,9 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace rend::render {
@@ -13,5 +16,19 @@ struct Mesh {
     std::vector<Eigen::Vector3f> colors;   ///< per vertex, linear RGB in [0,1]
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
+
+/// Throws std::invalid_argument, naming `who`, when the attribute arrays differ in length or a
+/// triangle indexes past the vertices: what every consumer of a Mesh relies on.
+inline void checkMesh(const Mesh& mesh, std::string_view who) {
+    const std::size_t n = mesh.positions.size();
+    const auto fail = [&](const char* what) {
+        throw std::invalid_argument(std::string(who) + ": " + what);
+    };
+    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
+        fail("mesh attribute arrays differ in length");
+    for (const auto& t : mesh.triangles)
+        for (std::uint32_t v : t)
+            if (v >= n) fail("triangle index out of range");
+}
 
 }  // namespace rend::render

@@ -99,15 +99,6 @@ void drawGround(const RenderSettings& s) {
     }
 }
 
-void checkMesh(const Mesh& mesh) {
-    const std::size_t n = mesh.positions.size();
-    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
-        throw std::invalid_argument("OsmesaRenderer: mesh attribute arrays differ in length");
-    for (const auto& t : mesh.triangles)
-        for (std::uint32_t v : t)
-            if (v >= n) throw std::invalid_argument("OsmesaRenderer: triangle index out of range");
-}
-
 void drawMesh(const Mesh& mesh, const RenderSettings& s) {
     if (mesh.triangles.empty()) return;
     glEnableClientState(GL_VERTEX_ARRAY);
@@ -199,7 +190,7 @@ OsmesaRenderer::~OsmesaRenderer() {
 Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings) {
     if (settings.width <= 0 || settings.height <= 0)
         throw std::invalid_argument("OsmesaRenderer: image size must be positive");
-    checkMesh(mesh);
+    checkMesh(mesh, "OsmesaRenderer");
     const int ss = std::max(1, settings.supersample);
     const int w = settings.width * ss;
     const int h = settings.height * ss;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -101,6 +102,8 @@ public:
         : text_(text), source_(source), base_(baseDepth) {}
 
     void run() {
+        // toml++ skips a UTF-8 byte order mark and does not count it as a column.
+        if (text_.starts_with("\xef\xbb\xbf")) pos_ = 3;
         while (pos_ < text_.size()) step(text_[pos_]);
     }
 
@@ -113,6 +116,10 @@ private:
     };
 
     void step(char c) {
+        // TOML allows other characters only in strings and comments; refusing them here also
+        // keeps toml++ 3.3 from classifying them, which reaches undefined behaviour for many
+        // (marzer/tomlplusplus#295).
+        if (!isAscii(c)) notAscii("ASCII outside strings and comments");
         if (c == ' ' || c == '\t' || c == '\r') return advance();
         if (c == '\n') {
             lineStart_ = frames_.empty();
@@ -210,7 +217,7 @@ private:
         while (pos_ < text_.size()) {
             const char c = text_[pos_];
             if (c == '\\' && quote == '"') {
-                advance(2);
+                multiLine ? skipMultiLineEscape() : advance(2);
             } else if (multiLine && text_.substr(pos_, 3) == triple) {
                 advance(3);
                 // Up to two more quotes belong to the content: """a"""" ends with a quote.
@@ -225,6 +232,32 @@ private:
                 advance();
             }
         }
+    }
+
+    /// After a backslash in a """ string toml++ 3.3 tests the next character, or after a
+    /// line-ending backslash the first one that is not whitespace, as whitespace, and reaches
+    /// undefined behaviour for many non-ASCII ones (marzer/tomlplusplus#190, #295).
+    void skipMultiLineEscape() {
+        advance();
+        while (pos_ < text_.size() && isWhitespace(text_[pos_])) advance();
+        if (pos_ < text_.size() && !isAscii(text_[pos_])) {
+            notAscii(
+                "an ASCII character first after a backslash in a \"\"\" string (toml++ 3.3 "
+                "misreads others, marzer/tomlplusplus#190)");
+        }
+        advance();
+    }
+
+    static bool isAscii(char c) { return static_cast<unsigned char>(c) < 0x80; }
+    static bool isWhitespace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+    [[noreturn]] void notAscii(std::string_view expected) const {
+        char found[32];
+        std::snprintf(found, sizeof found, "the byte 0x%02X",
+                      static_cast<unsigned char>(text_[pos_]));
+        throw SceneError(formatError(location(position_), "", expected, found,
+                                     "Quote the text, write the character as an escape such as "
+                                     "\\u00e9 inside a string, or remove it."));
     }
 
     void skipComment() {

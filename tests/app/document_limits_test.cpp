@@ -202,6 +202,16 @@ TEST_F(DocumentLimits, APresetIsMeasuredInsideMaterial) {
               0u);
 }
 
+TEST_F(DocumentLimits, APresetThatIsADeviceIsRefusedByName) {
+    fs::create_directories(dir_ / "assets" / "materials");
+    fs::create_symlink("/dev/zero", dir_ / "assets" / "materials" / "endless.toml");
+    setenv("REND_ASSETS", (dir_ / "assets").c_str(), 1);
+    EXPECT_EQ(errorOf(kStretch, {"material.preset=endless"}),
+              (dir_ / "assets" / "materials" / "endless.toml").string() +
+                  ": error: expected a material preset, found a character device. Give the path "
+                  "of a .toml file (or a pipe).");
+}
+
 // ---- size and kind of file --------------------------------------------------------------------
 
 TEST_F(DocumentLimits, AFileOverSixteenMebibytesIsRefusedBeforeItIsRead) {

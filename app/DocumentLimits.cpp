@@ -60,6 +60,7 @@ std::string readUpTo(int fd, std::size_t limit, const std::string& name, std::st
 std::string readDocument(const std::filesystem::path& file, std::string_view what) {
     const std::string name = file.string();
     const std::string expected = "a " + std::string(what);
+    const std::string limit = std::to_string(kMaxDocumentBytes >> 20) + " MiB limit";
     const auto refuse = [&](const std::string& found, std::string_view fix) {
         throw SceneError(formatError(name, "", expected, found, fix));
     };
@@ -73,18 +74,18 @@ std::string readDocument(const std::filesystem::path& file, std::string_view wha
         refuse(fileKind(info.st_mode), "Give the path of a .toml file (or a pipe).");
     }
     if (regular && std::size_t(info.st_size) > kMaxDocumentBytes) {
-        refuse(std::to_string(info.st_size) + " bytes, over the 16 MiB limit",
+        refuse(std::to_string(info.st_size) + " bytes, over the " + limit,
                "Scenes are a few kilobytes; check that this is the scene file.");
     }
     // Back to blocking reads, so a pipe is read until its writer closes it.
     ::fcntl(in.fd, F_SETFL, ::fcntl(in.fd, F_GETFL) & ~O_NONBLOCK);
     std::string text = readUpTo(in.fd, kMaxDocumentBytes + 1, name, what);
     if (text.size() > kMaxDocumentBytes) {
-        refuse("more than the 16 MiB limit (reading stopped there)",
+        refuse("more than the " + limit + " (reading stopped there)",
                "Check that this is the scene file; a device or an endless pipe never ends.");
     }
     if (text.empty() && !regular) {
-        refuse("nothing (a pipe that no process writes)",
+        refuse("nothing (an empty pipe, or one that no process writes)",
                "Start the writer first, or save the scene to a file and give its path.");
     }
     return text;
@@ -93,12 +94,12 @@ std::string readDocument(const std::filesystem::path& file, std::string_view wha
 namespace {
 
 /// A small TOML tokenizer that knows only what changes the depth: table headers, keys (dotted
-/// or not), arrays and inline tables. Everything else (numbers, dates, booleans) is stepped over,
-/// and what toml++ would reject is left for it to report; the scan only has to never count less
-/// than toml++ will build.
-class NestingScan {
+/// or not), arrays and inline tables, and where strings and comments begin and end. Everything
+/// else (numbers, dates, booleans) is stepped over, and what toml++ would reject is left for it
+/// to report; the scan only has to never count less than toml++ will build.
+class PreParseScan {
 public:
-    NestingScan(std::string_view text, const std::string& source, int baseDepth)
+    PreParseScan(std::string_view text, const std::string& source, int baseDepth)
         : text_(text), source_(source), base_(baseDepth) {}
 
     void run() {
@@ -338,8 +339,8 @@ private:
 
 }  // namespace
 
-void checkNesting(std::string_view text, const std::string& source, int baseDepth) {
-    NestingScan(text, source, baseDepth).run();
+void checkBeforeParsing(std::string_view text, const std::string& source, int baseDepth) {
+    PreParseScan(text, source, baseDepth).run();
 }
 
 }  // namespace rend::scene

@@ -31,10 +31,12 @@ inline constexpr std::size_t kMaxKeyLength = 256;
 /// file"). Throws SceneError.
 std::string readDocument(const std::filesystem::path& file, std::string_view what);
 
-/// Throws SceneError at the first place where `text` nests deeper than kMaxNesting or has a key
-/// longer than kMaxKeyLength. `baseDepth` counts the levels the text will sit under (1 for a
+/// Throws SceneError at the first place where `text` nests deeper than kMaxNesting, has a key
+/// longer than kMaxKeyLength, or has a non-ASCII byte where toml++ 3.3 would reach undefined
+/// behaviour on it (outside strings and comments, which TOML forbids anyway, and first after a
+/// backslash in a """ string). `baseDepth` counts the levels the text will sit under (1 for a
 /// preset, merged into [material]); `source` is the path the parser will report, a file or a
 /// --set label. Strings and comments are skipped, so brackets and dots in them do not count.
-void checkNesting(std::string_view text, const std::string& source, int baseDepth = 0);
+void checkBeforeParsing(std::string_view text, const std::string& source, int baseDepth = 0);
 
 }  // namespace rend::scene

@@ -19,7 +19,7 @@ constexpr std::string_view kSetExample = "KEY=VALUE, e.g. --set material.E=3e4";
 /// Parses TOML text whose nodes will report `sourcePath` as their location, after checking that
 /// it nests no deeper than the parser's stack allows (`baseDepth` levels above it).
 toml::table parseText(std::string_view text, std::string sourcePath, int baseDepth = 0) {
-    checkNesting(text, sourcePath, baseDepth);
+    checkBeforeParsing(text, sourcePath, baseDepth);
     try {
         return toml::parse(text, std::move(sourcePath));
     } catch (const toml::parse_error& e) {
@@ -172,13 +172,13 @@ void applyOverride(toml::table& document, std::string_view override) {
     const std::string_view key = trim(override.substr(0, equals));
     if (key.empty()) badOverride(label, "", kSetExample, "an empty key");
     const std::vector<std::string> segments = splitKey(key, label);
-    checkNesting(key, label);
+    checkBeforeParsing(key, label);
     const std::string_view text = trim(override.substr(equals + 1));
     if (text.empty()) {
         badOverride(label, key, "a value after '='", "nothing",
                     "Give one, e.g. --set material.E=3e4, or leave out this --set.");
     }
-    checkNesting("v = " + std::string(text), label, int(segments.size()) - 1);
+    checkBeforeParsing("v = " + std::string(text), label, int(segments.size()) - 1);
 
     toml::table value = parseOverrideValue(text, label);
     toml::node* parent = &document;

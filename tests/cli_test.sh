@@ -146,7 +146,7 @@ check "endless pipe message" grep -q "found more than the 16 MiB limit" "$tmp/st
 check "a piped scene is read" bash -c "'$rend' check /dev/stdin <scenes/stretch.toml >/dev/null"
 mkfifo "$tmp/fifo.toml"
 check "a FIFO nobody writes is refused at once" bash -c "timeout 10 '$rend' check '$tmp/fifo.toml' 2>'$tmp/stderr'; [[ \$? -eq 2 ]]"
-check "FIFO message" grep -q "a pipe that no process writes" "$tmp/stderr"
+check "FIFO message" grep -q "one that no process writes" "$tmp/stderr"
 printf 'x = 1\xc3\xa9\n' >"$tmp/utf8.toml"
 check "non-ASCII outside strings refused" run 2 check "$tmp/utf8.toml"
 check "non-ASCII located" grep -q "utf8.toml:1:6: error: expected ASCII" "$tmp/stderr"

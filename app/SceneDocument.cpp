@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 
 #include "app/DocumentLimits.h"
@@ -16,8 +15,8 @@ namespace {
 
 constexpr std::string_view kSetExample = "KEY=VALUE, e.g. --set material.E=3e4";
 
-/// Parses TOML text whose nodes will report `sourcePath` as their location, after checking that
-/// it nests no deeper than the parser's stack allows (`baseDepth` levels above it).
+/// Parses TOML text whose nodes will report `sourcePath` as their location, after the checks of
+/// app/DocumentLimits.h (`baseDepth` levels above it).
 toml::table parseText(std::string_view text, std::string sourcePath, int baseDepth = 0) {
     checkBeforeParsing(text, sourcePath, baseDepth);
     try {

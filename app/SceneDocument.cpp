@@ -2,12 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 
+#include "app/DocumentLimits.h"
 #include "app/SceneError.h"
 #include "app/SceneReader.h"
 
@@ -18,24 +15,10 @@ namespace {
 
 constexpr std::string_view kSetExample = "KEY=VALUE, e.g. --set material.E=3e4";
 
-std::string readFile(const fs::path& file, std::string_view what) {
-    std::error_code ec;
-    if (fs::is_directory(file, ec)) {
-        throw SceneError(file.string() + ": error: cannot open " + std::string(what) +
-                         " (it is a directory)");
-    }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
-        throw SceneError(file.string() + ": error: cannot open " + std::string(what) + " (" +
-                         std::strerror(errno) + ")");
-    }
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
-
-/// Parses TOML text whose nodes will report `sourcePath` as their location.
-toml::table parseText(std::string_view text, std::string sourcePath) {
+/// Parses TOML text whose nodes will report `sourcePath` as their location, after the checks of
+/// app/DocumentLimits.h (`baseDepth` levels above it).
+toml::table parseText(std::string_view text, std::string sourcePath, int baseDepth = 0) {
+    checkBeforeParsing(text, sourcePath, baseDepth);
     try {
         return toml::parse(text, std::move(sourcePath));
     } catch (const toml::parse_error& e) {
@@ -44,9 +27,18 @@ toml::table parseText(std::string_view text, std::string sourcePath) {
     }
 }
 
+/// The location of a --set value: its text, shortened like other quoted input.
+std::string overrideLabel(std::string_view override) {
+    constexpr std::size_t kMaxShown = 80;
+    std::string label(kSetLabelPrefix);
+    if (override.size() <= kMaxShown) return label.append(override).append("'");
+    return label.append(override.substr(0, kMaxShown)).append("...'");
+}
+
 [[noreturn]] void badOverride(const std::string& label, std::string_view key,
-                              std::string_view expected, std::string_view found) {
-    throw SceneError(formatError(label, key, expected, found, ""));
+                              std::string_view expected, std::string_view found,
+                              std::string_view fix = "") {
+    throw SceneError(formatError(label, key, expected, found, fix));
 }
 
 /// Parses the value as TOML ("3e4", "[0,0,1]", "\"disc\""); text that is not a single TOML
@@ -163,12 +155,12 @@ std::vector<std::string> presetNames(const fs::path& directory) {
 
 }  // namespace
 
-toml::table parseTomlFile(const fs::path& file, std::string_view what) {
-    return parseText(readFile(file, what), file.string());
+toml::table parseTomlFile(const fs::path& file, std::string_view what, int baseDepth) {
+    return parseText(readDocument(file, what), file.string(), baseDepth);
 }
 
 void applyOverride(toml::table& document, std::string_view override) {
-    const std::string label = std::string(kSetLabelPrefix) + std::string(override) + "'";
+    const std::string label = overrideLabel(override);
     const std::size_t equals = override.find('=');
     if (equals == std::string_view::npos) badOverride(label, "", kSetExample, "no '='");
     const auto trim = [](std::string_view s) {
@@ -179,8 +171,15 @@ void applyOverride(toml::table& document, std::string_view override) {
     const std::string_view key = trim(override.substr(0, equals));
     if (key.empty()) badOverride(label, "", kSetExample, "an empty key");
     const std::vector<std::string> segments = splitKey(key, label);
+    checkBeforeParsing(key, label);
+    const std::string_view text = trim(override.substr(equals + 1));
+    if (text.empty()) {
+        badOverride(label, key, "a value after '='", "nothing",
+                    "Give one, e.g. --set material.E=3e4, or leave out this --set.");
+    }
+    checkBeforeParsing("v = " + std::string(text), label, int(segments.size()) - 1);
 
-    toml::table value = parseOverrideValue(trim(override.substr(equals + 1)), label);
+    toml::table value = parseOverrideValue(text, label);
     toml::node* parent = &document;
     std::string parentPath;
     for (std::size_t i = 0; i + 1 < segments.size(); ++i) {
@@ -203,7 +202,7 @@ void mergeMaterialPreset(toml::table& document, const fs::path& assets) {
         unknownPreset(*preset, name, directory);
     }
 
-    toml::table values = parseTomlFile(directory / (name + ".toml"), "material preset");
+    toml::table values = parseTomlFile(directory / (name + ".toml"), "material preset", 1);
     if (const toml::node* nested = values.get("preset")) {
         throw SceneError(formatError(locationOf(nested->source()), "preset", "material values only",
                                      "another preset",

@@ -12,9 +12,11 @@
 
 namespace rend::scene {
 
-/// Parses a TOML file; a missing file or a syntax error becomes a SceneError naming it.
-/// `what` names the file in the message ("scene file", "material preset").
-toml::table parseTomlFile(const std::filesystem::path& file, std::string_view what);
+/// Parses a TOML file; a missing file, one past the limits of app/DocumentLimits.h or a syntax
+/// error becomes a SceneError naming it. `what` names the file in the message ("scene file",
+/// "material preset"); `baseDepth` counts the levels its values will sit under.
+toml::table parseTomlFile(const std::filesystem::path& file, std::string_view what,
+                          int baseDepth = 0);
 
 /// Applies one "dotted.key=value" override. An integer segment indexes an array (0-based);
 /// missing tables on the way are created, so unknown keys fail later like any other.

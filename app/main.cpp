@@ -101,6 +101,18 @@ int runCommand(const RunArgs& a) {
     return 0;
 }
 
+/// CLI11 stores `--frames ''` as an empty string, which reads like an absent option; an empty
+/// value is never what the user meant, so it is refused instead.
+CLI::Validator nonEmpty(const std::string& expected, const std::string& example) {
+    return CLI::Validator(
+        [=](std::string& value) {
+            return value.empty() ? "expected " + expected + ", found an empty value. Use e.g. " +
+                                       example + "."
+                                 : std::string();
+        },
+        "");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,14 +123,19 @@ int main(int argc, char** argv) {
 
     RunArgs run;
     CLI::App* runCmd = app.add_subcommand("run", "Simulate a scene and write its outputs");
-    runCmd->add_option("scene", run.scene, "Scene file (TOML)")->required();
-    runCmd->add_option("--out", run.out, "Output folder")->capture_default_str();
-    runCmd->add_option("--frames", run.frames, "Frames to write: N or FIRST-LAST");
+    const CLI::Validator sceneFile = nonEmpty("a scene file", "scenes/stretch.toml");
+    runCmd->add_option("scene", run.scene, "Scene file (TOML)")->required()->check(sceneFile);
+    runCmd->add_option("--out", run.out, "Output folder")
+        ->capture_default_str()
+        ->check(nonEmpty("an output folder", "--out out/stretch"));
+    runCmd->add_option("--frames", run.frames, "Frames to write: N or FIRST-LAST")
+        ->check(nonEmpty("N or FIRST-LAST", "--frames 1-10 (or leave --frames out for all)"));
     runCmd->add_option("--renderer", run.renderer, "Override [render] renderer")
         ->check(CLI::IsMember({"osmesa", "embree", "none"}));
     runCmd->add_option("--surface", run.surface, "Override [render] surface")
         ->check(CLI::IsMember({"lattice", "splat", "vdb"}));
-    runCmd->add_option("--export", run.exports, "Per-frame exports, e.g. ply,obj,glb,vdb");
+    runCmd->add_option("--export", run.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
+        ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
     runCmd->add_option("--spp", run.spp, "Path-traced samples per pixel (embree)")
         ->check(CLI::Range(1, 4096));
     runCmd->add_option("--threads", run.threads, "OpenMP threads (default: all cores)")
@@ -128,7 +145,7 @@ int main(int argc, char** argv) {
     std::string checkScene;
     std::vector<std::string> checkSets;
     CLI::App* checkCmd = app.add_subcommand("check", "Parse and validate a scene, write nothing");
-    checkCmd->add_option("scene", checkScene, "Scene file (TOML)")->required();
+    checkCmd->add_option("scene", checkScene, "Scene file (TOML)")->required()->check(sceneFile);
     checkCmd->add_option("--set", checkSets, "Override a scene value: key.path=value");
 
     try {

@@ -127,5 +127,47 @@ for surface in splat vdb; do
     done
 done
 
+# Hostile documents and options (issue 11): each refused with exit 2, a located message, and
+# nothing written; none may crash or hang.
+deep=$(python3 -c "print('.'.join(['a'] * 100000) + ' = 1')")
+echo "$deep" >"$tmp/deep_keys.toml"
+check "100000 dotted levels refused" run 2 check "$tmp/deep_keys.toml"
+check "deep message located with the limit" grep -q "deep_keys.toml:1:65: error: expected at most 32 levels" "$tmp/stderr"
+echo "[${deep% = 1}]" >"$tmp/deep_header.toml"
+check "100000-level header refused" run 2 run "$tmp/deep_header.toml" --out "$tmp/deep_out"
+check "deep header leaves no output" test ! -e "$tmp/deep_out"
+check "deep --set value refused" run 2 check scenes/stretch.toml --set "sheet.size=$(printf '[%.0s' {1..40})"
+check "deep --set located at the --set" grep -q "^--set 'sheet.size=\[\[\[.*error: expected at most 32 levels" "$tmp/stderr"
+check "/dev/zero refused at once" bash -c "timeout 10 '$rend' check /dev/zero 2>'$tmp/stderr'; [[ \$? -eq 2 ]]"
+check "/dev/zero message" grep -q "^/dev/zero: error: expected a scene file, found a character device" "$tmp/stderr"
+check "a directory refused" run 2 check scenes
+check "an endless pipe stops at 16 MiB" bash -c "yes | timeout 20 '$rend' check /dev/stdin 2>'$tmp/stderr'; [[ \$? -eq 2 ]]"
+check "endless pipe message" grep -q "found more than the 16 MiB limit" "$tmp/stderr"
+check "a piped scene is read" bash -c "'$rend' check /dev/stdin <scenes/stretch.toml >/dev/null"
+mkfifo "$tmp/fifo.toml"
+check "a FIFO nobody writes is refused at once" bash -c "timeout 10 '$rend' check '$tmp/fifo.toml' 2>'$tmp/stderr'; [[ \$? -eq 2 ]]"
+check "FIFO message" grep -q "one that no process writes" "$tmp/stderr"
+printf 'x = 1\xc3\xa9\n' >"$tmp/utf8.toml"
+check "non-ASCII outside strings refused" run 2 check "$tmp/utf8.toml"
+check "non-ASCII located" grep -q "utf8.toml:1:6: error: expected ASCII" "$tmp/stderr"
+printf 'solver = "fem_cst"\0\n' >"$tmp/nul.toml"
+check "NUL byte refused and located" run 2 check "$tmp/nul.toml"
+check "NUL byte located" grep -q "nul.toml:1:19: error: TOML syntax" "$tmp/stderr"
+for option in --frames --export --out; do
+    out=(--out "$tmp/empty_option")
+    [[ $option == --out ]] && out=()
+    check "$option '' refused" run 2 run scenes/stretch.toml "${small[@]}" "${out[@]}" "$option" ''
+    check "$option '' names the option" grep -q "^$option: expected .*, found an empty value" "$tmp/stderr"
+done
+check "empty options leave no output" test ! -e "$tmp/empty_option"
+check "empty scene path refused" run 2 check ''
+check "--set without a value refused" run 2 check scenes/stretch.toml --set 'material.E='
+check "--set without a value message" grep -q "^--set 'material.E=': error: material.E: expected a value after '='" "$tmp/stderr"
+check "--set '' refused" run 2 check scenes/stretch.toml --set ''
+check "--set =x refused" run 2 check scenes/stretch.toml --set '=x'
+check "--threads 0 refused" run 2 run scenes/stretch.toml --threads 0 --out "$tmp/threads0"
+check "--frames given twice refused" run 2 run scenes/stretch.toml --frames 1 --frames 2 --out "$tmp/twice"
+check "refused options leave no output" bash -c "! ls -d '$tmp/threads0' '$tmp/twice' '$tmp/bad_out' 2>/dev/null | grep -q ."
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -74,7 +74,9 @@ constexpr double kMaxEstimatedSeconds = 6 * 3600;
 constexpr double kMaxStepsPerFrame = 1e9;
 constexpr double kMaxTotalSteps = 1e15;
 
+/// Three digits; beyond 1e30 the figure only says "absurd", and never prints inf.
 std::string roundedText(double value) {
+    if (!(value <= 1e30)) return "over 1e30";
     char text[32];
     std::snprintf(text, sizeof text, "%.3g", value);
     return text;
@@ -83,6 +85,7 @@ std::string roundedText(double value) {
 std::string durationText(double seconds) {
     if (seconds < 120) return roundedText(seconds) + " s";
     if (seconds < 7200) return roundedText(seconds / 60) + " min";
+    if (!(seconds <= 3.6e15)) return "over 1e12 h";
     return roundedText(seconds / 3600) + " h";
 }
 

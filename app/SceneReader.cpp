@@ -223,19 +223,21 @@ std::string KeyLog::unusedMessage(const Entry& entry, const toml::key& key,
     return errorAt(locationOf(where), message);
 }
 
-std::optional<std::string> KeyLog::firstUnknown(std::size_t entry) const {
-    const Entry& e = entries_[entry];
-    const toml::key* first = nullptr;
-    const toml::node* firstValue = nullptr;
-    for (const auto& [key, value] : *e.table) {
-        if (e.section->find(key.str())) continue;
-        if (!first || isBefore(value.source().begin, firstValue->source().begin)) {
-            first = &key;
-            firstValue = &value;
+std::optional<std::string> KeyLog::firstUnknown() const {
+    for (const Entry& e : entries_) {
+        const toml::key* first = nullptr;
+        const toml::node* firstValue = nullptr;
+        for (const auto& [key, value] : *e.table) {
+            if (e.section->find(key.str())) continue;
+            // The first typo in reading order, not the map's alphabetical order.
+            if (!first || isBefore(value.source().begin, firstValue->source().begin)) {
+                first = &key;
+                firstValue = &value;
+            }
         }
+        if (first) return unusedMessage(e, *first, *firstValue);
     }
-    if (!first) return std::nullopt;
-    return unusedMessage(e, *first, *firstValue);
+    return std::nullopt;
 }
 
 void KeyLog::reportUnused() const {
@@ -305,7 +307,7 @@ void TableReader::fail(std::string_view key, std::string_view expected, std::str
 }
 
 void TableReader::missing(std::string_view key, std::string_view constraint) const {
-    if (auto unknown = log_->firstUnknown(entry_)) throw SceneError(*unknown);
+    if (auto unknown = log_->firstUnknown()) throw SceneError(*unknown);
     const Param& p = param(key);
     std::string message = keyPath(p.key) + " is missing: expected " + std::string(p.meaning);
     if (!constraint.empty()) message += " (" + std::string(constraint) + ")";

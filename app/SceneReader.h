@@ -121,9 +121,9 @@ public:
     /// Throws SceneError naming every key present but not read, each at its location with a
     /// did-you-mean among the keys its section declares.
     void reportUnused() const;
-    /// The first undeclared key of an entry, as a message, if any (a likely cause of a missing
-    /// required key).
-    std::optional<std::string> firstUnknown(std::size_t entry) const;
+    /// The first undeclared key of the tables visited so far, as a message, if any: the likely
+    /// cause of a missing required key ("materal" when material.E is missing).
+    std::optional<std::string> firstUnknown() const;
 
     /// "file:line:column" of every value read and every table visited, by dotted key path.
     const std::map<std::string, std::string, std::less<>>& locations() const { return locations_; }

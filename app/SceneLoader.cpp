@@ -437,6 +437,13 @@ void readTime(const TableReader& root, Scene& scene) {
     scene.allowSlow = t.boolean("allow_slow").value_or(scene.allowSlow);
     time.integrator =
         sim::Integrator(t.choice("integrator").value_or(std::size_t(time.integrator)));
+    // Frame k shows t = k / fps: with no whole frame inside duration, the one frame written
+    // would simulate past it (1e3 s for fps = 1e-3).
+    if (time.duration * time.fps < 0.5) {
+        t.fail(t.has("fps") ? "fps" : "duration", "at least one frame (duration * fps >= 0.5)",
+               formatNumber(time.duration * time.fps) + " frames",
+               "Raise fps or lengthen duration.");
+    }
     if (time.duration * time.fps > kMaxFrames) {
         t.fail(t.has("duration") ? "duration" : "fps", "at most 1e6 frames (duration * fps)",
                formatNumber(std::round(time.duration * time.fps)) + " frames",

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "app/FrameWriter.h"
@@ -26,20 +27,96 @@ void checkTimeStep(const Scene& scene, const sim::Membrane& membrane) {
     if (!t.dt || t.allowUnstable || *t.dt <= membrane.stableTimeStep() * (1.0 + 1e-12)) return;
     const auto& m = scene.sim.material;
     std::ostringstream msg;
-    msg << scene.dtLocation << ": error: time.dt: expected at most the stable limit "
+    msg << scene.locationOf("time.dt") << ": error: time.dt: expected at most the stable limit "
         << membrane.stableTimeStep() << " s for E=" << m.youngsModulus << " Pa, rho=" << m.density
         << " kg/m^3, dx=" << scene.sim.sheet.dx << " m (Silling-Askari bound), found " << *t.dt
         << ". Use dt <= " << t.safety * membrane.stableTimeStep() << " or dt = \"auto\".";
     throw SceneError(msg.str());
 }
 
+/// Where a region was given: its box or edge, else the entry.
+std::string regionLocation(const Scene& scene, const std::string& entry) {
+    for (const char* key : {".box", ".edge"}) {
+        if (scene.locations.contains(entry + key)) return scene.locationOf(entry + key);
+    }
+    return scene.locationOf(entry);
+}
+
 void checkBoundaries(const Scene& scene, const sim::Membrane& membrane) {
     const std::vector<int> counts = membrane.boundaryParticleCounts();
-    for (std::size_t k = 0; k < counts.size(); ++k)
-        if (counts[k] == 0)
-            throw SceneError(scene.file.string() + ": error: boundary " + std::to_string(k) +
-                             ": expected a region that holds particles, found none inside it. "
-                             "Widen its depth or box, or check it against the sheet's size.");
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        if (counts[k] != 0) continue;
+        const std::string entry = "boundary." + std::to_string(k);
+        throw SceneError(regionLocation(scene, entry) + ": error: " + entry +
+                         ": expected a region that holds particles, found none inside it. "
+                         "Widen its depth or box, or check it against the sheet's size.");
+    }
+}
+
+/// Notches that lie on the sheet's bounding box but between particles (or in a disc's corner)
+/// cut nothing; the loader already refused those off the sheet.
+void checkNotches(const Scene& scene, const sim::Membrane& membrane) {
+    if (scene.sim.notches.empty() || membrane.notchedBondCount() > 0) return;
+    throw SceneError(scene.locationOf("notch.0.points") +
+                     ": error: notch.0.points: expected notches that cross at least one bond, "
+                     "found none crossed. Extend the polyline across the sheet's particles.");
+}
+
+// Conservative costs per explicit step, from run.json's ns_per_particle_step on one core
+// (47 ns with 3 bonds per particle, 306 ns with 17, the SPH 300 ns), rounded up.
+constexpr double kNsPerParticle = 300;
+constexpr double kNsPerBondEnd = 10;
+/// Diffusion sub-steps visit each bond once more and each particle's source list.
+constexpr double kNsPerDiffusionParticle = 20;
+/// Runs estimated beyond this many seconds on one core are refused unless allow_slow.
+constexpr double kMaxEstimatedSeconds = 6 * 3600;
+/// Beyond these, counters overflow (int steps per frame, int diffusion sub-steps, long steps).
+constexpr double kMaxStepsPerFrame = 1e9;
+constexpr double kMaxTotalSteps = 1e15;
+
+/// Three digits; beyond 1e30 the figure only says "absurd", and never prints inf.
+std::string roundedText(double value) {
+    if (!(value <= 1e30)) return "over 1e30";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", value);
+    return text;
+}
+
+std::string durationText(double seconds) {
+    if (seconds < 120) return roundedText(seconds) + " s";
+    if (seconds < 7200) return roundedText(seconds / 60) + " min";
+    if (!(seconds <= 3.6e15)) return "over 1e12 h";
+    return roundedText(seconds / 3600) + " h";
+}
+
+/// The key whose value drives the estimate furthest from an ordinary run.
+std::string costDriver(const Scene& scene, const RunEstimate& e) {
+    if (e.diffusionSeconds > e.seconds - e.diffusionSeconds) return "material.conductivity";
+    const double steps = e.stepsPerFrame / 1e3, particles = e.particles / 1e5,
+                 frames = e.frames / 1e3;
+    if (particles >= steps && particles >= frames) return "sheet.dx";
+    if (frames >= steps) return "time.duration";
+    return scene.sim.time.dt ? "time.dt" : "material.density";
+}
+
+void checkCost(const Scene& scene, const RunEstimate& e) {
+    const bool impossible = e.stepsPerFrame > kMaxStepsPerFrame ||
+                            e.diffusionSubsteps > kMaxStepsPerFrame ||
+                            e.stepsPerFrame * e.frames > kMaxTotalSteps;
+    if (!impossible && (e.seconds <= kMaxEstimatedSeconds || scene.allowSlow)) return;
+    const std::string key = costDriver(scene, e);
+    const std::string expected =
+        impossible
+            ? "at most 1e9 steps per frame, 1e9 diffusion sub-steps per step and 1e15 "
+              "steps in all"
+            : "a run estimated within " + durationText(kMaxEstimatedSeconds) + " on one core";
+    const std::string fix =
+        impossible ? "Raise dt or lower the material's stiffness-to-density ratio, conductivity "
+                     "or the duration."
+                   : "Coarsen dx, shorten the duration, raise dt or lower conductivity, or run "
+                     "anyway with --set time.allow_slow=true.";
+    throw SceneError(scene.locationOf(key) + ": error: " + key + ": expected " + expected +
+                     ", found " + describeEstimate(e) + ". " + fix);
 }
 
 class Progress {
@@ -110,6 +187,41 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
 
 }  // namespace
 
+RunEstimate estimateRun(const Scene& scene, const sim::Membrane& membrane) {
+    RunEstimate e;
+    e.frames = scene.frameCount();
+    e.particles = membrane.particleCount();
+    e.bonds = double(membrane.bondCount());
+    const double interval = 1.0 / scene.sim.time.fps;
+    e.stepsPerFrame = std::max(1.0, std::ceil(interval / membrane.timeStep() * (1.0 - 1e-12)));
+    const double steps = e.stepsPerFrame * e.frames;
+    const sim::Diffusion* diffusion = membrane.diffusion();
+    if (diffusion && std::isfinite(diffusion->stableTimeStep())) {
+        const double h = interval / e.stepsPerFrame;
+        e.diffusionSubsteps = std::max(1.0, std::ceil(h / (0.9 * diffusion->stableTimeStep())));
+    }
+    e.particleSteps = steps * e.particles;
+    e.bondSteps = steps * 2 * e.bonds;
+    const double stepNs = e.particles * kNsPerParticle + 2 * e.bonds * kNsPerBondEnd;
+    const double diffusionNs =
+        e.diffusionSubsteps * (e.particles * kNsPerDiffusionParticle + 2 * e.bonds * kNsPerBondEnd);
+    e.diffusionSeconds = steps * diffusionNs * 1e-9;
+    e.seconds = steps * stepNs * 1e-9 + e.diffusionSeconds;
+    e.bytes = estimateSheet(scene.sim.sheet).bytes;
+    return e;
+}
+
+std::string describeEstimate(const RunEstimate& e) {
+    std::string text = roundedText(e.stepsPerFrame * e.frames) + " steps (" +
+                       roundedText(e.stepsPerFrame) + " per frame x " + std::to_string(e.frames) +
+                       " frames)";
+    if (e.diffusionSubsteps > 0)
+        text += ", " + roundedText(e.diffusionSubsteps) + " diffusion sub-steps per step";
+    return text + ", " + roundedText(e.particleSteps) + " particle-steps, " +
+           roundedText(e.bondSteps) + " bond-steps: about " + durationText(e.seconds) +
+           " on one core";
+}
+
 sim::Membrane prepareMembrane(const Scene& scene) {
     sim::Membrane membrane = [&] {
         try {
@@ -120,6 +232,8 @@ sim::Membrane prepareMembrane(const Scene& scene) {
     }();
     checkTimeStep(scene, membrane);
     checkBoundaries(scene, membrane);
+    checkNotches(scene, membrane);
+    checkCost(scene, estimateRun(scene, membrane));
     return membrane;
 }
 
@@ -154,11 +268,13 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.dt = dt;
     s.stableDt = membrane.stableTimeStep();
     s.substeps = substeps;
+    std::fprintf(stderr, "estimate: %s\n", describeEstimate(estimateRun(scene, membrane)).c_str());
     const int frames = scene.frameCount();
     const auto [first, last] = options.frames.value_or(std::pair{1, frames});
 
     std::filesystem::create_directories(options.outDir);
-    StatsWriter stats(options.outDir / "stats.csv");
+    std::optional<StatsWriter> stats;
+    if (scene.writeStats) stats.emplace(options.outDir / "stats.csv");
     FrameWriter writer(scene, options.outDir);
     Progress progress(options.progressBar, last);
     s.seconds.setup = secondsSince(t0);
@@ -168,7 +284,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.extraSubsteps = membrane.extraSubsteps();
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
-        stats.finish();
+        if (stats) stats->finish();
         writeFileAtomic(options.outDir / "run.json",
                         runJson(scene, s, status, stateHash(membrane)));
     };
@@ -178,8 +294,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             for (int k = 0; k < substeps; ++k) membrane.step();
             s.seconds.simulate += secondsSince(t0);
             s.framesSimulated = frame;
-            stats.append({frame, membrane.time(), membrane.kineticEnergy(), membrane.strainEnergy(),
-                          membrane.maxSpeed(), membrane.maxTheta(), membrane.brokenBondCount()});
+            if (stats)
+                stats->append({frame, membrane.time(), membrane.kineticEnergy(),
+                               membrane.strainEnergy(), membrane.maxSpeed(), membrane.maxTheta(),
+                               membrane.brokenBondCount()});
             std::vector<std::string> wrote;
             if (frame >= first && writer.active()) {
                 membrane.updateDamage();

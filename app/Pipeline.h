@@ -41,8 +41,27 @@ struct RunSummary {
     double nsPerParticleStep = 0.0;
 };
 
+/// What a run will cost, estimated before it starts (conservative figures for one core).
+struct RunEstimate {
+    int frames = 0;
+    double particles = 0;
+    double bonds = 0;
+    double stepsPerFrame = 0;
+    double diffusionSubsteps = 0;  ///< per explicit step; 0 without diffusion
+    double particleSteps = 0;
+    double bondSteps = 0;  ///< bond ends visited, over the whole run
+    double seconds = 0;    ///< on one core
+    double diffusionSeconds = 0;
+    double bytes = 0;  ///< estimateSheet's memory
+};
+
+RunEstimate estimateRun(const Scene& scene, const sim::Membrane& membrane);
+/// "50000 steps (417 per frame x 120 frames), ...: about 3.5 min on one core".
+std::string describeEstimate(const RunEstimate& estimate);
+
 /// Builds the membrane and checks what only a built membrane can tell (dt against the stable
-/// bound, boundary regions that claim no particle). Throws SceneError. Writes nothing.
+/// bound, boundary regions that claim no particle, notches that cut nothing, the estimated cost
+/// against its limit). Throws SceneError located at the key that caused it. Writes nothing.
 sim::Membrane prepareMembrane(const Scene& scene);
 
 /// Steps per frame and the dt that lands frames exactly on k / fps, never above `dt`.

@@ -2,7 +2,9 @@
 // A validated scene: everything `rend run` needs, with every value range-checked at load.
 
 #include <filesystem>
+#include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "render/RenderSettings.h"
@@ -23,15 +25,38 @@ struct Scene {
     bool writeStats = true;
     std::vector<ExportFormat> exports;  ///< [output] export, in the order given
 
-    /// "file:line:column" of the time.dt value (or of [time] when dt is "auto"), so the
-    /// pipeline can point at it when dt exceeds the stable bound.
-    std::string dtLocation;
+    /// Whether a run estimated beyond the cost limit may start ([time] allow_slow).
+    bool allowSlow = false;
+
+    /// "file:line:column" (or "--set '...'") of every value and table read, by dotted key
+    /// path ("time.dt", "boundary.1.box", "boundary.1"), so checks made after set-up can point
+    /// at what caused them.
+    std::map<std::string, std::string, std::less<>> locations;
 
     /// The resolved scene (preset merged, --set applied) as JSON, for run.json.
     std::string resolvedJson;
 
     int frameCount() const;  ///< round(duration * fps), at least 1
+
+    /// Where `key` was given; else where its nearest enclosing table was; else the file.
+    std::string locationOf(std::string_view key) const;
 };
+
+/// What a sheet will cost in memory before it is built: the particle count from the outline's
+/// area, the bonds per particle from the horizon (lattice points within R = horizon * dx).
+struct SheetEstimate {
+    /// Positions, velocities, rest positions, forces, masses, theta and the solvers'
+    /// per-particle arrays; measured at about 170 B, rounded up.
+    static constexpr double kBytesPerParticle = 400;
+    /// Partner, rest length, weight, alive, strength and the solver's per-bond state, each bond
+    /// stored from both ends; measured at about 32 B per end, rounded up.
+    static constexpr double kBytesPerBondEnd = 40;
+
+    double particles = 0;
+    double bondsPerParticle = 0;  ///< bond ends per particle
+    double bytes = 0;
+};
+SheetEstimate estimateSheet(const sim::SheetParams& sheet);
 
 /// Parses and validates a scene file; `overrides` are "key.path=value" strings from --set,
 /// applied before validation with the same checks. Throws SceneError.

@@ -1,5 +1,6 @@
-// Scene schema: every key, its range, its default and an example live here, next to each other,
-// and every value is checked once, at load. Unknown keys are errors, never warnings.
+// Scene loader: reads every table by the keys declared in SceneSchema.cpp, checks what one key
+// alone cannot (shapes, switches, sizes against the sheet), and records where each value came from.
+// Every key present but never read is an error (KeyLog::reportUnused).
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -11,43 +12,30 @@
 #include "app/Scene.h"
 #include "app/SceneDocument.h"
 #include "app/SceneError.h"
+#include "app/SceneNames.h"
 #include "app/SceneReader.h"
 
 namespace rend {
 namespace {
 
 using scene::formatNumber;
-using scene::Param;
-using scene::Range;
 using scene::TableReader;
 
-// Each list follows its enum's order, so a choice's index converts straight to the enum.
-constexpr std::string_view kShapes[] = {"rectangle", "disc", "sphere"};
-constexpr std::string_view kLattices[] = {"hexagonal", "square"};
-constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
-constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 enum class Edge { Left, Right, Bottom, Top };
-constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
-constexpr std::string_view kRenderers[] = {"osmesa", "none", "embree"};
-constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
-constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};
-constexpr std::string_view kExportFormats[] = {"ply", "obj", "glb", "vdb"};
-constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
 
-/// Above this the lattice alone needs gigabytes and a frame takes minutes.
-constexpr double kMaxParticles = 5e6;
+/// The lattice, its bonds and the solvers' per-particle arrays must fit in this much memory.
+constexpr double kMaxMemoryBytes = 8e9;
 /// Fewer particles across than this cannot bend or stretch in any meaningful way.
 constexpr double kMinParticlesAcross = 4;
 /// Guards frameCount() against int overflow; ~11 hours of video at 24 fps.
 constexpr double kMaxFrames = 1e6;
-
-std::string sectionFix(std::string_view name) {
-    return "Write it as a table: a [" + std::string(name) + "] header followed by its keys.";
-}
+/// [[diffusion.scatter]] entries together; the per-step source loop visits each spot.
+constexpr double kMaxScatteredSpots = 1e5;
 
 /// Two significant digits, so limits and suggestions read like something a person would type;
 /// `direction` (-1, 0, +1) rounds down, to nearest or up, to keep a quoted limit valid.
 double roundForDisplay(double value, int direction = 0) {
+    if (!std::isfinite(value) || value <= 0.0) return value;
     const int exponent = int(std::floor(std::log10(value))) - 1;
     const double scaled = value / std::pow(10.0, exponent);
     const double rounded = direction < 0   ? std::floor(scaled)
@@ -78,6 +66,8 @@ SheetExtent extentOf(const sim::SheetParams& sheet) {
     return e;
 }
 
+std::string gigabytes(double bytes) { return formatNumber(roundForDisplay(bytes / 1e9)) + " GB"; }
+
 // ---- [sheet] ---------------------------------------------------------------------------------
 
 /// A key that only makes sense for one shape is an error for the other, so a forgotten
@@ -91,23 +81,20 @@ void rejectForShape(const TableReader& t, std::string_view key, std::string_view
 }
 
 void readOutline(const TableReader& t, sim::SheetParams& s) {
-    constexpr Param kShape{"shape", "the sheet's outline", "\"rectangle\""};
-    constexpr Param kSize{"size", "the rectangle's extent [x, y] in metres", "[2.0, 2.0]"};
-    constexpr Param kRadius{"radius", "the disc or sphere radius in metres", "1.0"};
-    s.outline = sim::Outline(t.choice(kShape, kShapes).value_or(0));
+    s.outline = sim::Outline(t.choice("shape").value_or(0));
     if (s.outline == sim::Outline::Rectangle) {
-        if (!t.has(kSize.key)) t.missing(kSize, "2 numbers > 0");
-        s.size = *t.vec2(kSize, Range::positive());
-        rejectForShape(t, kRadius.key, "rectangle", "Remove radius, or set shape = \"disc\".");
+        if (!t.has("size")) t.missing("size", "2 numbers > 0");
+        s.size = *t.vec2("size");
+        rejectForShape(t, "radius", "rectangle", "Remove radius, or set shape = \"disc\".");
     } else {
-        s.radius = t.requiredNumber(kRadius, Range::positive());
-        rejectForShape(t, kSize.key, kShapes[std::size_t(s.outline)],
+        s.radius = t.requiredNumber("radius");
+        rejectForShape(t, "size", names::kShapes[std::size_t(s.outline)],
                        "Remove size and give radius instead.");
     }
 }
 
-/// dx is bounded by the outline on both sides: coarse enough to fit the particle budget, fine
-/// enough to resolve the sheet at all.
+/// dx is bounded by the outline on both sides: coarse enough for the memory budget, fine enough
+/// to resolve the sheet at all.
 void checkSpacing(const TableReader& t, const sim::SheetParams& s) {
     const SheetExtent e = extentOf(s);
     const double maxDx = e.smallest / (kMinParticlesAcross - 1);
@@ -120,51 +107,40 @@ void checkSpacing(const TableReader& t, const sim::SheetParams& s) {
                formatNumber(s.dx),
                "Use e.g. dx = " + formatNumber(roundForDisplay(e.smallest / 50)) + ".");
     }
-    const double estimate = e.area / (s.dx * s.dx);
-    if (estimate > kMaxParticles) {
-        const double minDx = std::sqrt(e.area / kMaxParticles);
+    const SheetEstimate estimate = estimateSheet(s);
+    if (estimate.bytes > kMaxMemoryBytes) {
+        // Memory grows as 1/dx^2 at a fixed horizon, so this dx fits the budget.
+        const double minDx = s.dx * std::sqrt(estimate.bytes / kMaxMemoryBytes);
         t.fail("dx",
-               "a spacing of at least " + formatNumber(roundForDisplay(minDx, +1)) +
-                   " m, so that the sheet has at most 5e6 particles (area / dx^2)",
-               formatNumber(s.dx) + ", about " + formatNumber(std::round(estimate)) + " particles",
-               "Use e.g. dx = " + formatNumber(roundForDisplay(minDx * 2)) + ".");
+               "a spacing that fits the memory limit of " + gigabytes(kMaxMemoryBytes) +
+                   " (particles x (" + formatNumber(SheetEstimate::kBytesPerParticle) +
+                   " bytes + bonds x " + formatNumber(SheetEstimate::kBytesPerBondEnd) +
+                   " bytes)), i.e. dx >= " + formatNumber(roundForDisplay(minDx, +1)) +
+                   " m at horizon = " + formatNumber(s.horizonFactor),
+               formatNumber(s.dx) + ": about " + formatNumber(roundForDisplay(estimate.particles)) +
+                   " particles with " + formatNumber(std::round(estimate.bondsPerParticle)) +
+                   " bonds each, about " + gigabytes(estimate.bytes),
+               "Use e.g. dx = " + formatNumber(roundForDisplay(minDx * 2, +1)) +
+                   ", or a smaller horizon.");
     }
 }
 
 sim::SheetParams readSheet(const TableReader& root) {
-    constexpr Param kSheet{"sheet", "the membrane's outline and lattice", ""};
-    const TableReader t = root.section(kSheet, "[sheet]",
-                                       {"shape", "size", "radius", "center", "lattice", "dx",
-                                        "horizon", "thickness", "perturbation", "seed"},
-                                       sectionFix("sheet"));
-    constexpr Param kDx{"dx", "the particle spacing in metres", "0.02"};
-    constexpr Param kCenter{"center", "the sheet's centre [x, y, z] in metres", "[0.0, 0.0, 0.0]"};
-    constexpr Param kLattice{"lattice", "the particle arrangement", "\"hexagonal\""};
-    constexpr Param kHorizon{"horizon", "the bond cutoff in units of dx", "1.5"};
-    constexpr Param kThickness{"thickness", "the membrane thickness in metres", "0.001"};
-    constexpr Param kPerturbation{"perturbation", "the out-of-plane jitter amplitude in metres",
-                                  "1e-4"};
-    constexpr Param kSeed{"seed", "the jitter's random seed", "7"};
-
+    const TableReader t = root.section("sheet");
     sim::SheetParams s;
-    s.dx = t.requiredNumber(kDx, Range::positive());
+    s.dx = t.requiredNumber("dx");
     readOutline(t, s);
-    s.center = t.vec3(kCenter).value_or(s.center);
-    s.lattice = sim::LatticeKind(t.choice(kLattice, kLattices).value_or(std::size_t(s.lattice)));
-    s.horizonFactor = t.number(kHorizon, Range::openClosed(1.0, 6.0)).value_or(s.horizonFactor);
-    s.thickness = t.number(kThickness, Range::positive()).value_or(s.thickness);
-    s.perturbationAmplitude =
-        t.number(kPerturbation, Range::nonNegative()).value_or(s.perturbationAmplitude);
-    s.perturbationSeed =
-        std::uint64_t(t.integer(kSeed, Range::nonNegative()).value_or(s.perturbationSeed));
+    s.center = t.vec3("center").value_or(s.center);
+    s.lattice = sim::LatticeKind(t.choice("lattice").value_or(std::size_t(s.lattice)));
+    s.horizonFactor = t.number("horizon").value_or(s.horizonFactor);
+    s.thickness = t.number("thickness").value_or(s.thickness);
+    s.perturbationAmplitude = t.number("perturbation").value_or(s.perturbationAmplitude);
+    s.perturbationSeed = std::uint64_t(t.integer("seed").value_or(s.perturbationSeed));
     checkSpacing(t, s);
     return s;
 }
 
 // ---- [material] ------------------------------------------------------------------------------
-
-constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
-constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper"};
 
 /// A key that only matters once another key is chosen ("switch") is an error when that switch
 /// is absent altogether: otherwise a forgotten law = "power_law" silently gives a linear sheet.
@@ -183,100 +159,52 @@ void requireSwitch(const TableReader& t, std::string_view key, std::string_view 
 
 /// Bond law of eqs. 18-20 and its constants.
 void readBondLaw(const TableReader& t, sim::MaterialParams& m) {
-    constexpr Param kLaw{"law", "the bond law: eq. 18, 19 or 20 of the membrane paper",
-                         "\"linear\""};
-    constexpr Param kPowerRatio{"power_ratio", "c*/c of the power law, eq. 19", "-0.1"};
-    constexpr Param kPowerExponent{"power_exponent", "the exponent n of the power law, eq. 19",
-                                   "4"};
-    // Table 1 lists eta0 for every material; only the elastoplastic law (eqs. 20, 27) uses it.
-    constexpr Param kYieldStrain{"yield_strain", "the elastic limit eta0 of eqs. 20 and 27",
-                                 "1e-4"};
-    constexpr Param kSoftening{"softening", "beta of eqs. 20 and 27, the post-yield decay", "1.0"};
-
-    requireSwitch(t, kPowerRatio.key, kLaw.key, "it belongs to law = \"power_law\"",
+    requireSwitch(t, "power_ratio", "law", "it belongs to law = \"power_law\"",
                   "Add law = \"power_law\", or remove power_ratio.");
-    requireSwitch(t, kPowerExponent.key, kLaw.key, "it belongs to law = \"power_law\"",
+    requireSwitch(t, "power_exponent", "law", "it belongs to law = \"power_law\"",
                   "Add law = \"power_law\", or remove power_exponent.");
-    requireSwitch(t, kSoftening.key, kLaw.key, "it belongs to law = \"elastoplastic\"",
+    requireSwitch(t, "softening", "law", "it belongs to law = \"elastoplastic\"",
                   "Add law = \"elastoplastic\", or remove softening.");
-    m.law = sim::BondLawKind(t.choice(kLaw, kLaws).value_or(std::size_t(m.law)));
-    m.powerLawRatio = t.number(kPowerRatio, Range::atMost(0.0)).value_or(m.powerLawRatio);
-    m.powerLawExponent = t.number(kPowerExponent, Range::above(1.0)).value_or(m.powerLawExponent);
-    m.yieldStrain = t.number(kYieldStrain, Range::positive()).value_or(m.yieldStrain);
-    m.softening = t.number(kSoftening, Range::positive()).value_or(m.softening);
+    m.law = sim::BondLawKind(t.choice("law").value_or(std::size_t(m.law)));
+    m.powerLawRatio = t.number("power_ratio").value_or(m.powerLawRatio);
+    m.powerLawExponent = t.number("power_exponent").value_or(m.powerLawExponent);
+    // Table 1 lists eta0 for every material; only the elastoplastic law (eqs. 20, 27) uses it.
+    m.yieldStrain = t.number("yield_strain").value_or(m.yieldStrain);
+    m.softening = t.number("softening").value_or(m.softening);
 }
 
 /// fracture_energy is a number, or "none" for an unbreakable sheet (the default), so that a
 /// preset's fracture can be switched off with --set material.fracture_energy=none.
 void readFracture(const TableReader& t, sim::MaterialParams& m) {
-    constexpr Param kFractureEnergy{"fracture_energy", "the fracture energy G_f in J/m^2", "11.3"};
-    constexpr Param kCriticalStretch{"critical_stretch",
-                                     "how the critical stretch follows from G_f", "\"calibrated\""};
-    constexpr Param kStrengthLoss{
-        "strength_loss", "the critical stretch lost per unit theta (acid, moisture)", "0.6"};
-    requireSwitch(t, kCriticalStretch.key, kFractureEnergy.key, "bonds never break without it",
+    requireSwitch(t, "critical_stretch", "fracture_energy", "bonds never break without it",
                   "Add e.g. fracture_energy = 11.3, or remove critical_stretch.");
-    requireSwitch(t, kStrengthLoss.key, kFractureEnergy.key, "bonds never break without it",
+    requireSwitch(t, "strength_loss", "fracture_energy", "bonds never break without it",
                   "Add e.g. fracture_energy = 11.3, or remove strength_loss.");
-    if (const toml::node* node = t.find(kFractureEnergy.key)) {
-        if (const auto* text = node->as_string(); text && text->get() == "none") {
-            m.fractureEnergy.reset();
-        } else if (node->is_number()) {
-            m.fractureEnergy = t.number(kFractureEnergy, Range::positive());
-        } else {
-            t.fail(kFractureEnergy.key,
-                   "a number > 0 (the fracture energy G_f in J/m^2) or \"none\" (unbreakable)",
-                   scene::describeType(*node),
-                   "Use e.g. fracture_energy = 11.3 or fracture_energy = \"none\".");
-        }
-    }
+    m.fractureEnergy = t.numberOrWord("fracture_energy", m.fractureEnergy);
     m.criticalStretch = sim::CriticalStretchMode(
-        t.choice(kCriticalStretch, kCriticalStretches).value_or(std::size_t(m.criticalStretch)));
-    m.strengthLoss = t.number(kStrengthLoss, Range::nonNegative()).value_or(m.strengthLoss);
-    constexpr Param kSurfaceCorrection{
-        "surface_correction", "whether edge particles are stiffened to the interior's", "true"};
-    m.surfaceCorrection = t.boolean(kSurfaceCorrection).value_or(m.surfaceCorrection);
+        t.choice("critical_stretch").value_or(std::size_t(m.criticalStretch)));
+    m.strengthLoss = t.number("strength_loss").value_or(m.strengthLoss);
+    m.surfaceCorrection = t.boolean("surface_correction").value_or(m.surfaceCorrection);
 }
 
 /// The diffusive quantity theta inside the material (eq. 25) and what it does to it.
 void readDiffusivity(const TableReader& t, sim::MaterialParams& m) {
-    constexpr Param kCapacity{"capacity", "the diffusive capacity C of eq. 25", "1.0"};
-    constexpr Param kConductivity{"conductivity", "the coefficient of diffusion k of eq. 25",
-                                  "0.01"};
-    constexpr Param kExpansion{"expansion", "alpha, the strain per unit theta", "0.3"};
-    constexpr Param kStiffnessLoss{"stiffness_loss", "the stiffness lost per unit theta", "0.5"};
-    m.capacity = t.number(kCapacity, Range::positive()).value_or(m.capacity);
-    m.conductivity = t.number(kConductivity, Range::nonNegative()).value_or(m.conductivity);
-    m.expansion = t.number(kExpansion, Range::any()).value_or(m.expansion);
-    m.stiffnessLoss = t.number(kStiffnessLoss, Range::nonNegative()).value_or(m.stiffnessLoss);
+    m.capacity = t.number("capacity").value_or(m.capacity);
+    m.conductivity = t.number("conductivity").value_or(m.conductivity);
+    m.expansion = t.number("expansion").value_or(m.expansion);
+    m.stiffnessLoss = t.number("stiffness_loss").value_or(m.stiffnessLoss);
 }
 
 sim::MaterialParams readMaterial(const TableReader& root) {
-    constexpr Param kMaterial{"material", "the membrane's material", ""};
-    const TableReader t =
-        root.section(kMaterial, "[material]",
-                     {"preset", "name", "E", "poisson", "density", "micromodulus", "law",
-                      "power_ratio", "power_exponent", "yield_strain", "softening",
-                      "fracture_energy", "critical_stretch", "capacity", "conductivity",
-                      "expansion", "stiffness_loss", "strength_loss", "surface_correction"},
-                     sectionFix("material"));
-    constexpr Param kPreset{"preset", "a file name under assets/materials without .toml",
-                            "\"stretch_sheet\""};
-    constexpr Param kName{"name", "the material's name", "\"rubber\""};
-    constexpr Param kE{"E", "Young's modulus in Pa", "2e4"};
-    constexpr Param kPoisson{"poisson", "Poisson's ratio", "0.3"};
-    constexpr Param kDensity{"density", "the density in kg/m^3", "5000"};
-    constexpr Param kMicromodulus{"micromodulus", "how the bond stiffness is derived",
-                                  "\"calibrated\""};
-
+    const TableReader t = root.section("material");
     sim::MaterialParams m;
-    const std::optional<std::string> preset = t.string(kPreset);  // merged already; type-check
-    m.name = t.string(kName).value_or(preset.value_or(m.name));
-    m.youngsModulus = t.requiredNumber(kE, Range::positive());
-    m.poissonRatio = t.number(kPoisson, Range::open(-1.0, 0.5)).value_or(m.poissonRatio);
-    m.density = t.requiredNumber(kDensity, Range::positive());
-    m.micromodulus = sim::MicromodulusMode(
-        t.choice(kMicromodulus, kMicromoduli).value_or(std::size_t(m.micromodulus)));
+    const std::optional<std::string> preset = t.string("preset");  // merged already; type-check
+    m.name = t.string("name").value_or(preset.value_or(m.name));
+    m.youngsModulus = t.requiredNumber("E");
+    m.poissonRatio = t.number("poisson").value_or(m.poissonRatio);
+    m.density = t.requiredNumber("density");
+    m.micromodulus =
+        sim::MicromodulusMode(t.choice("micromodulus").value_or(std::size_t(m.micromodulus)));
     readBondLaw(t, m);
     readFracture(t, m);
     readDiffusivity(t, m);
@@ -284,14 +212,6 @@ sim::MaterialParams readMaterial(const TableReader& root) {
 }
 
 // ---- [[boundary]] ----------------------------------------------------------------------------
-
-constexpr Param kEdge{"edge",
-                      "the region: edge = \"left\" | \"right\" | \"bottom\" | \"top\", or box = "
-                      "{ min = [x, y], max = [x, y] }",
-                      "\"left\""};
-constexpr Param kBox{"box", "the region's corners in rest coordinates",
-                     "{ min = [-1.0, -1.0], max = [-0.9, 1.0] }"};
-constexpr Param kDepth{"depth", "the strip width in units of dx", "1.0"};
 
 /// The strip of width depth*dx along one side of the sheet's rest bounding box. The outer
 /// side stays unbounded and the inner one gets a hair of tolerance, so the particles exactly on
@@ -318,17 +238,14 @@ sim::Region edgeRegion(Edge edge, double depth, const sim::SheetParams& sheet) {
 }
 
 sim::Region boxRegion(const TableReader& t) {
-    constexpr Param kMin{"min", "the box's lower corner [x, y] in metres", "[-1.0, -1.0]"};
-    constexpr Param kMax{"max", "the box's upper corner [x, y] in metres", "[-0.9, 1.0]"};
-    const TableReader box =
-        *t.subtable(kBox, t.keyPath("box"), {"min", "max"}, TableReader::useInstead(kBox));
-    if (!box.has(kMin.key)) box.missing(kMin, "");
-    if (!box.has(kMax.key)) box.missing(kMax, "");
+    const TableReader box = *t.subtable("box");
+    if (!box.has("min")) box.missing("min");
+    if (!box.has("max")) box.missing("max");
     sim::Region r;
-    r.min = *box.vec2(kMin);
-    r.max = *box.vec2(kMax);
+    r.min = *box.vec2("min");
+    r.max = *box.vec2("max");
     if ((r.min.array() >= r.max.array()).any()) {
-        t.fail("box", "min < max in both x and y (" + std::string(kBox.meaning) + ")",
+        t.fail("box", "min < max in both x and y (" + std::string(t.param("box").meaning) + ")",
                "min = [" + formatNumber(r.min.x()) + ", " + formatNumber(r.min.y()) + "], max = [" +
                    formatNumber(r.max.x()) + ", " + formatNumber(r.max.y()) + "]",
                "Swap the offending coordinates.");
@@ -341,16 +258,15 @@ sim::Region readRegion(const TableReader& t, const sim::SheetParams& sheet) {
         t.fail("box", "either edge or box, not both", "both", "Remove edge or box.");
     }
     if (t.has("box")) {
-        if (t.has("depth")) {
+        if (const toml::node* depth = t.find("depth")) {
             t.fail("depth", "no depth with box (depth applies to edge regions)",
-                   scene::describeType(*t.find("depth")),
-                   "Remove depth, or use edge instead of box.");
+                   scene::describeType(*depth), "Remove depth, or use edge instead of box.");
         }
         return boxRegion(t);
     }
-    if (!t.has("edge")) t.missing(kEdge, "");
-    const Edge edge = Edge(*t.choice(kEdge, kEdges));
-    return edgeRegion(edge, t.number(kDepth, Range::positive()).value_or(1.0), sheet);
+    if (!t.has("edge")) t.missing("edge", "or box = { min = [x, y], max = [x, y] }");
+    const Edge edge = Edge(*t.choice("edge"));
+    return edgeRegion(edge, t.number("depth").value_or(1.0), sheet);
 }
 
 /// Keys that only a velocity condition uses are errors on a pinned one, not silently ignored.
@@ -361,107 +277,86 @@ void rejectForPinned(const TableReader& t, std::string_view key) {
     }
 }
 
-sim::BoundaryCondition readBoundary(const toml::table& table, std::size_t index,
-                                    const sim::SheetParams& sheet) {
-    const std::string path = "boundary." + std::to_string(index);
-    const TableReader t(table, path, "[[boundary]] entry " + std::to_string(index),
-                        {"type", "edge", "depth", "box", "velocity", "ramp"});
-    constexpr Param kType{"type", "the kind of condition", "\"velocity\""};
-    constexpr Param kVelocity{"velocity", "the prescribed velocity [x, y, z] in m/s",
-                              "[0.15, 0.0, 0.0]"};
-    constexpr Param kRamp{"ramp", "seconds to reach full speed from rest", "0.5"};
-
+sim::BoundaryCondition readBoundary(const TableReader& t, const sim::SheetParams& sheet) {
     sim::BoundaryCondition bc;
-    if (!t.has(kType.key)) t.missing(kType, "one of \"velocity\", \"pinned\"");
-    bc.kind = sim::BoundaryKind(*t.choice(kType, kBoundaryTypes));
+    if (!t.has("type")) t.missing("type", "one of \"velocity\", \"pinned\"");
+    bc.kind = sim::BoundaryKind(*t.choice("type"));
     bc.region = readRegion(t, sheet);
     if (bc.kind == sim::BoundaryKind::Pinned) {
-        rejectForPinned(t, kVelocity.key);
-        rejectForPinned(t, kRamp.key);
+        rejectForPinned(t, "velocity");
+        rejectForPinned(t, "ramp");
         return bc;
     }
-    if (!t.has(kVelocity.key)) t.missing(kVelocity, "");
-    bc.velocity = *t.vec3(kVelocity);
-    bc.rampTime = t.number(kRamp, Range::nonNegative()).value_or(bc.rampTime);
+    if (!t.has("velocity")) t.missing("velocity");
+    bc.velocity = *t.vec3("velocity");
+    bc.rampTime = t.number("ramp").value_or(bc.rampTime);
     return bc;
-}
-
-/// The tables of an array of tables such as [[boundary]]; absent reads as none.
-std::vector<const toml::table*> tablesOf(const TableReader& parent, std::string_view key,
-                                         std::string_view header) {
-    const toml::node* node = parent.find(key);
-    if (!node) return {};
-    const std::string expected = "an array of tables written as [[" + std::string(header) + "]]";
-    const std::string fix = "Give each entry its own [[" + std::string(header) + "]] header.";
-    const toml::array* array = node->as_array();
-    if (!array) parent.fail(key, expected, scene::describeType(*node), fix);
-    std::vector<const toml::table*> tables;
-    for (const toml::node& item : *array) {
-        const toml::table* table = item.as_table();
-        if (!table) {
-            parent.fail(key, expected, "an array containing " + scene::describeType(item), fix);
-        }
-        tables.push_back(table);
-    }
-    return tables;
 }
 
 std::vector<sim::BoundaryCondition> readBoundaries(const TableReader& root,
                                                    const sim::SheetParams& sheet) {
     std::vector<sim::BoundaryCondition> conditions;
-    for (const toml::table* table : tablesOf(root, "boundary", "boundary")) {
-        conditions.push_back(readBoundary(*table, conditions.size(), sheet));
-    }
+    for (const TableReader& t : root.entries("boundary"))
+        conditions.push_back(readBoundary(t, sheet));
     return conditions;
 }
 
 // ---- [[notch]] -------------------------------------------------------------------------------
 
-sim::Notch readNotch(const toml::table& table, std::size_t index) {
-    const TableReader t(table, "notch." + std::to_string(index),
-                        "[[notch]] entry " + std::to_string(index), {"points"});
-    constexpr Param kPoints{"points", "the notch polyline in rest coordinates, metres",
-                            "[[-1.0, 0.0], [-0.6, 0.0]]"};
-    if (!t.has(kPoints.key)) t.missing(kPoints, "at least 2 points");
+/// A notch whose polyline misses the sheet's rest bounding box cuts nothing.
+void checkNotchMeetsSheet(const TableReader& t, const sim::Notch& notch,
+                          const sim::SheetParams& sheet) {
+    const SheetExtent e = extentOf(sheet);
+    Eigen::Vector2d lo = notch.points.front(), hi = lo;
+    for (const Eigen::Vector2d& p : notch.points) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    if ((hi.array() >= e.min.array()).all() && (lo.array() <= e.max.array()).all()) return;
+    t.fail("points",
+           "a polyline that meets the sheet, whose rest extent is x in [" +
+               formatNumber(e.min.x()) + ", " + formatNumber(e.max.x()) + "], y in [" +
+               formatNumber(e.min.y()) + ", " + formatNumber(e.max.y()) + "]",
+           "one within x in [" + formatNumber(lo.x()) + ", " + formatNumber(hi.x()) + "], y in [" +
+               formatNumber(lo.y()) + ", " + formatNumber(hi.y()) + "]",
+           "Move the notch onto the sheet.");
+}
+
+sim::Notch readNotch(const TableReader& t, const sim::SheetParams& sheet) {
+    if (!t.has("points")) t.missing("points", "at least 2 points");
     sim::Notch notch;
-    notch.points = *t.points(kPoints, 2);
+    notch.points = *t.points("points", 2);
     for (std::size_t i = 1; i < notch.points.size(); ++i) {
         if (notch.points[i] == notch.points[i - 1]) {
             const Eigen::Vector2d& p = notch.points[i];
-            t.fail(kPoints.key,
-                   "consecutive points that differ (" + std::string(kPoints.meaning) + ")",
-                   "point " + std::to_string(i) + " repeating [" + formatNumber(p.x()) + ", " +
-                       formatNumber(p.y()) + "]",
-                   "Remove the repeated point.");
+            t.fail(
+                "points",
+                "consecutive points that differ (" + std::string(t.param("points").meaning) + ")",
+                "point " + std::to_string(i) + " repeating [" + formatNumber(p.x()) + ", " +
+                    formatNumber(p.y()) + "]",
+                "Remove the repeated point.");
         }
     }
+    checkNotchMeetsSheet(t, notch, sheet);
     return notch;
 }
 
-std::vector<sim::Notch> readNotches(const TableReader& root) {
+std::vector<sim::Notch> readNotches(const TableReader& root, const sim::SheetParams& sheet) {
     std::vector<sim::Notch> notches;
-    for (const toml::table* table : tablesOf(root, "notch", "notch")) {
-        notches.push_back(readNotch(*table, notches.size()));
-    }
+    for (const TableReader& t : root.entries("notch")) notches.push_back(readNotch(t, sheet));
     return notches;
 }
 
 // ---- [diffusion] -----------------------------------------------------------------------------
 
-constexpr Param kSourceRadius{"radius", "the source's radius in metres", "0.05"};
-constexpr Param kSourceRate{"rate", "theta added per second inside it (negative: a sink)", "1.0"};
-constexpr Param kSourceStart{"start", "the time in seconds it switches on", "0.0"};
-constexpr Param kSourceDuration{"duration", "how many seconds it stays on (default: forever)",
-                                "2.0"};
-
 /// A spot whose disc misses the sheet's rest bounding box would silently do nothing.
-void checkSpotReachesSheet(const TableReader& t, const Param& kCenter, const sim::DiffusionSpot& s,
+void checkSpotReachesSheet(const TableReader& t, const sim::DiffusionSpot& s,
                            const sim::SheetParams& sheet) {
     const SheetExtent e = extentOf(sheet);
     const Eigen::Vector2d nearest = s.center.cwiseMax(e.min).cwiseMin(e.max);
     const double distance = (s.center - nearest).norm();
     if (distance <= s.radius) return;
-    t.fail(kCenter.key,
+    t.fail("center",
            "a centre within radius = " + formatNumber(s.radius) +
                " m of the sheet, whose rest extent is x in [" + formatNumber(e.min.x()) + ", " +
                formatNumber(e.max.x()) + "], y in [" + formatNumber(e.min.y()) + ", " +
@@ -471,136 +366,89 @@ void checkSpotReachesSheet(const TableReader& t, const Param& kCenter, const sim
            "Move the spot onto the sheet or enlarge its radius.");
 }
 
-sim::DiffusionSpot readSpot(const toml::table& table, std::size_t index,
-                            const sim::SheetParams& sheet) {
-    const TableReader t(table, "diffusion.spot." + std::to_string(index),
-                        "[[diffusion.spot]] entry " + std::to_string(index),
-                        {"center", "radius", "rate", "start", "duration"});
-    constexpr Param kCenter{"center", "the spot's centre [x, y] in rest coordinates, metres",
-                            "[0.0, 0.0]"};
+sim::DiffusionSpot readSpot(const TableReader& t, const sim::SheetParams& sheet) {
     sim::DiffusionSpot s;
-    if (!t.has(kCenter.key)) t.missing(kCenter, "2 numbers");
-    s.center = *t.vec2(kCenter);
-    s.radius = t.requiredNumber(kSourceRadius, Range::positive());
-    s.rate = t.requiredNumber(kSourceRate, Range::any());
-    s.start = t.number(kSourceStart, Range::nonNegative()).value_or(s.start);
-    s.duration = t.number(kSourceDuration, Range::positive()).value_or(s.duration);
-    checkSpotReachesSheet(t, kCenter, s, sheet);
+    if (!t.has("center")) t.missing("center", "2 numbers");
+    s.center = *t.vec2("center");
+    s.radius = t.requiredNumber("radius");
+    s.rate = t.requiredNumber("rate");
+    s.start = t.number("start").value_or(s.start);
+    s.duration = t.number("duration").value_or(s.duration);
+    checkSpotReachesSheet(t, s, sheet);
     return s;
 }
 
-/// Each scatter expands to `count` spots; the cap keeps set-up and the per-step source loop sane.
-constexpr double kMaxScatterCount = 1e4;
-
-sim::SpotScatter readScatter(const toml::table& table, std::size_t index) {
-    const TableReader t(table, "diffusion.scatter." + std::to_string(index),
-                        "[[diffusion.scatter]] entry " + std::to_string(index),
-                        {"count", "radius", "rate", "start", "spread", "duration", "seed"});
-    constexpr Param kCount{"count", "how many spots or droplets", "20"};
-    constexpr Param kSpread{"spread",
-                            "seconds over which droplets are emitted; 0: all spots at once", "3.0"};
-    constexpr Param kSeed{"seed", "the placement's random seed", "1"};
-    const Range countRange = Range::closed(1, kMaxScatterCount);
+sim::SpotScatter readScatter(const TableReader& t) {
     sim::SpotScatter s;
-    if (!t.has(kCount.key)) t.missing(kCount, "an integer " + countRange.describe());
-    s.count = int(*t.integer(kCount, countRange));
-    s.radius = t.requiredNumber(kSourceRadius, Range::positive());
-    s.rate = t.requiredNumber(kSourceRate, Range::any());
-    s.start = t.number(kSourceStart, Range::nonNegative()).value_or(s.start);
-    s.spread = t.number(kSpread, Range::nonNegative()).value_or(s.spread);
-    s.duration = t.number(kSourceDuration, Range::positive()).value_or(s.duration);
-    s.seed = std::uint64_t(t.integer(kSeed, Range::nonNegative()).value_or(s.seed));
+    if (!t.has("count")) t.missing("count", "an integer " + t.param("count").range.describe());
+    s.count = int(*t.integer("count"));
+    s.radius = t.requiredNumber("radius");
+    s.rate = t.requiredNumber("rate");
+    s.start = t.number("start").value_or(s.start);
+    s.spread = t.number("spread").value_or(s.spread);
+    s.duration = t.number("duration").value_or(s.duration);
+    s.seed = std::uint64_t(t.integer("seed").value_or(s.seed));
     return s;
 }
 
-sim::DiffusionEdge readDiffusionEdge(const toml::table& table, std::size_t index,
-                                     const sim::SheetParams& sheet) {
-    const TableReader t(table, "diffusion.edge." + std::to_string(index),
-                        "[[diffusion.edge]] entry " + std::to_string(index),
-                        {"edge", "depth", "box", "value"});
-    constexpr Param kValue{"value", "the theta held on the region", "1.0"};
+sim::DiffusionEdge readDiffusionEdge(const TableReader& t, const sim::SheetParams& sheet) {
     sim::DiffusionEdge e;
     e.region = readRegion(t, sheet);
-    e.value = t.requiredNumber(kValue, Range::any());
+    e.value = t.requiredNumber("value");
     return e;
 }
 
 sim::DiffusionParams readDiffusion(const TableReader& root, const sim::SheetParams& sheet) {
-    const TableReader t = root.section(
-        {"diffusion", "the diffusive quantity theta (acid, heat, moisture)", ""}, "[diffusion]",
-        {"initial", "spot", "scatter", "edge"}, sectionFix("diffusion"));
-    constexpr Param kInitial{"initial", "theta everywhere at t = 0", "0.0"};
+    const TableReader t = root.section("diffusion");
     sim::DiffusionParams d;
-    d.initial = t.number(kInitial, Range::any()).value_or(d.initial);
-    for (const toml::table* table : tablesOf(t, "spot", "diffusion.spot")) {
-        d.spots.push_back(readSpot(*table, d.spots.size(), sheet));
+    d.initial = t.number("initial").value_or(d.initial);
+    for (const TableReader& spot : t.entries("spot")) d.spots.push_back(readSpot(spot, sheet));
+    double scattered = 0;
+    for (const TableReader& scatter : t.entries("scatter")) {
+        d.scatters.push_back(readScatter(scatter));
+        scattered += d.scatters.back().count;
+        if (scattered > kMaxScatteredSpots) {
+            scatter.fail("count", "at most 1e5 scattered spots in all [[diffusion.scatter]]",
+                         formatNumber(scattered) + " so far", "Lower count, or merge the entries.");
+        }
     }
-    for (const toml::table* table : tablesOf(t, "scatter", "diffusion.scatter")) {
-        d.scatters.push_back(readScatter(*table, d.scatters.size()));
-    }
-    for (const toml::table* table : tablesOf(t, "edge", "diffusion.edge")) {
-        d.edges.push_back(readDiffusionEdge(*table, d.edges.size(), sheet));
-    }
+    for (const TableReader& edge : t.entries("edge"))
+        d.edges.push_back(readDiffusionEdge(edge, sheet));
     return d;
 }
 
 // ---- [forces], [time] ------------------------------------------------------------------------
 
 void readForces(const TableReader& root, sim::MembraneParams& p) {
-    const TableReader t = root.section({"forces", "external forces", ""}, "[forces]",
-                                       {"gravity", "damping", "pressure"}, sectionFix("forces"));
-    constexpr Param kGravity{"gravity", "the gravitational acceleration [x, y, z] in m/s^2",
-                             "[0.0, 0.0, -9.81]"};
-    constexpr Param kDamping{"damping", "the velocity damping rate in 1/s", "0.1"};
-    p.gravity = t.vec3(kGravity).value_or(p.gravity);
-    p.damping = t.number(kDamping, Range::nonNegative()).value_or(p.damping);
-    constexpr Param kPressure{"pressure", "a uniform pressure on the +z side in Pa", "100.0"};
-    p.pressure = t.number(kPressure, Range::any()).value_or(p.pressure);
+    const TableReader t = root.section("forces");
+    p.gravity = t.vec3("gravity").value_or(p.gravity);
+    p.damping = t.number("damping").value_or(p.damping);
+    p.pressure = t.number("pressure").value_or(p.pressure);
 }
 
-/// dt is a number or "auto"; returns where it was given, for the stability message.
-std::string readTimeStep(const TableReader& t, sim::TimeParams& time) {
-    constexpr Param kDt{"dt", "the time step in seconds", "1e-4"};
-    const toml::node* node = t.find(kDt.key);
-    if (!node) return t.location();
-    if (const auto* text = node->as_string(); text && text->get() == "auto") {
-        time.dt.reset();
-    } else if (node->is_number()) {
-        time.dt = t.number(kDt, Range::positive());
-    } else {
-        t.fail(kDt.key, "a number > 0 (the time step in seconds) or \"auto\"",
-               scene::describeType(*node), "Use e.g. dt = 1e-4 or dt = \"auto\".");
-    }
-    return t.location(kDt.key);
-}
-
-std::string readTime(const TableReader& root, sim::TimeParams& time) {
-    const TableReader t = root.section(
-        {"time", "time stepping", ""}, "[time]",
-        {"dt", "safety", "duration", "fps", "allow_unstable", "integrator"}, sectionFix("time"));
-    constexpr Param kSafety{"safety", "the fraction of the stable time step used by dt = \"auto\"",
-                            "0.8"};
-    constexpr Param kDuration{"duration", "the simulated time in seconds", "5.0"};
-    constexpr Param kFps{"fps", "the output frames per simulated second", "24"};
-    constexpr Param kAllowUnstable{"allow_unstable", "whether dt may exceed the stable bound",
-                                   "false"};
-
-    const std::string dtLocation = readTimeStep(t, time);
-    time.safety = t.number(kSafety, Range::openClosed(0.0, 1.0)).value_or(time.safety);
-    time.duration = t.number(kDuration, Range::positive()).value_or(time.duration);
-    time.fps = t.number(kFps, Range::positive()).value_or(time.fps);
-    time.allowUnstable = t.boolean(kAllowUnstable).value_or(time.allowUnstable);
-    constexpr Param kIntegrator{"integrator", "the explicit scheme", "\"velocity_verlet\""};
-    static constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};
+void readTime(const TableReader& root, Scene& scene) {
+    const TableReader t = root.section("time");
+    sim::TimeParams& time = scene.sim.time;
+    time.dt = t.numberOrWord("dt", time.dt);
+    time.safety = t.number("safety").value_or(time.safety);
+    time.duration = t.number("duration").value_or(time.duration);
+    time.fps = t.number("fps").value_or(time.fps);
+    time.allowUnstable = t.boolean("allow_unstable").value_or(time.allowUnstable);
+    scene.allowSlow = t.boolean("allow_slow").value_or(scene.allowSlow);
     time.integrator =
-        sim::Integrator(t.choice(kIntegrator, kIntegrators).value_or(std::size_t(time.integrator)));
+        sim::Integrator(t.choice("integrator").value_or(std::size_t(time.integrator)));
+    // Frame k shows t = k / fps: with no whole frame inside duration, the one frame written
+    // would simulate past it (1e3 s for fps = 1e-3).
+    if (time.duration * time.fps < 0.5) {
+        t.fail(t.has("fps") ? "fps" : "duration", "at least one frame (duration * fps >= 0.5)",
+               formatNumber(time.duration * time.fps) + " frames",
+               "Raise fps or lengthen duration.");
+    }
     if (time.duration * time.fps > kMaxFrames) {
-        t.fail(t.has(kDuration.key) ? kDuration.key : kFps.key,
-               "at most 1e6 frames (duration * fps)",
+        t.fail(t.has("duration") ? "duration" : "fps", "at most 1e6 frames (duration * fps)",
                formatNumber(std::round(time.duration * time.fps)) + " frames",
                "Shorten duration or lower fps.");
     }
-    return dtLocation;
 }
 
 // ---- [camera], [light], [render], [output] ---------------------------------------------------
@@ -617,29 +465,20 @@ render::Camera defaultCamera(const sim::SheetParams& sheet) {
 }
 
 render::Camera readCamera(const TableReader& root, const sim::SheetParams& sheet) {
-    const TableReader t = root.section({"camera", "the camera", ""}, "[camera]",
-                                       {"position", "look_at", "up", "fov"}, sectionFix("camera"));
-    constexpr Param kPosition{"position", "the camera position [x, y, z] in metres",
-                              "[0.0, -4.0, 3.0]"};
-    constexpr Param kLookAt{"look_at", "the point the camera aims at [x, y, z] in metres",
-                            "[0.0, 0.0, 0.0]"};
-    constexpr Param kUp{"up", "the camera's up direction [x, y, z]", "[0.0, 0.0, 1.0]"};
-    constexpr Param kFov{"fov", "the vertical field of view in degrees", "40"};
-
+    const TableReader t = root.section("camera");
     render::Camera c = defaultCamera(sheet);
-    c.position = t.vec3(kPosition).value_or(c.position);
-    c.lookAt = t.vec3(kLookAt).value_or(c.lookAt);
-    c.up = t.vec3(kUp, Range::any(), true).value_or(c.up);
-    c.fovYDegrees = t.number(kFov, Range::open(1.0, 170.0)).value_or(c.fovYDegrees);
+    c.position = t.vec3("position").value_or(c.position);
+    c.lookAt = t.vec3("look_at").value_or(c.lookAt);
+    c.up = t.vec3("up", true).value_or(c.up);
+    c.fovYDegrees = t.number("fov").value_or(c.fovYDegrees);
 
     const Eigen::Vector3d view = c.lookAt - c.position;
     if (view.norm() == 0.0) {
-        t.fail(t.has(kPosition.key) ? kPosition.key : kLookAt.key,
-               "a position different from look_at", "both at the same point",
-               "Move the camera away from the point it looks at.");
+        t.fail(t.has("position") ? "position" : "look_at", "a position different from look_at",
+               "both at the same point", "Move the camera away from the point it looks at.");
     }
     if (view.normalized().cross(c.up.normalized()).norm() < 1e-6) {
-        t.fail(t.has(kUp.key) ? kUp.key : kPosition.key,
+        t.fail(t.has("up") ? "up" : "position",
                "an up direction not parallel to the view direction (look_at - position)",
                "them parallel", "Use e.g. up = [0.0, 0.0, 1.0] with a camera not straight above.");
     }
@@ -647,148 +486,101 @@ render::Camera readCamera(const TableReader& root, const sim::SheetParams& sheet
 }
 
 void readLight(const TableReader& root, render::RenderSettings& r) {
-    const TableReader t =
-        root.section({"light", "the lighting", ""}, "[light]",
-                     {"direction", "color", "intensity", "ambient"}, sectionFix("light"));
-    constexpr Param kDirection{"direction", "from the surface towards the light [x, y, z]",
-                               "[-0.4, -0.5, 1.0]"};
-    constexpr Param kColor{"color", "the light's colour [r, g, b]", "[1.0, 1.0, 1.0]"};
-    constexpr Param kIntensity{"intensity", "the light's strength", "0.85"};
-    constexpr Param kAmbient{"ambient", "the ambient light level", "0.25"};
-    r.sun.direction = t.vec3(kDirection, Range::any(), true).value_or(r.sun.direction);
-    r.sun.color = t.vec3(kColor, Range::nonNegative()).value_or(r.sun.color);
-    r.sun.intensity = t.number(kIntensity, Range::nonNegative()).value_or(r.sun.intensity);
-    r.ambient = t.number(kAmbient, Range::closed(0.0, 1.0)).value_or(r.ambient);
+    const TableReader t = root.section("light");
+    r.sun.direction = t.vec3("direction", true).value_or(r.sun.direction);
+    r.sun.color = t.vec3("color").value_or(r.sun.color);
+    r.sun.intensity = t.number("intensity").value_or(r.sun.intensity);
+    r.ambient = t.number("ambient").value_or(r.ambient);
 }
 
 std::optional<std::array<double, 2>> readColorRange(const TableReader& t) {
-    constexpr Param kColorRange{"color_range", "the values mapped to the ends of the colour map",
-                                "[0.0, 0.6]"};
-    const std::optional<Eigen::Vector2d> range = t.vec2(kColorRange);
+    const std::optional<Eigen::Vector2d> range = t.vec2("color_range");
     if (!range) return std::nullopt;
     if (range->x() >= range->y()) {
-        t.fail(kColorRange.key, "[lo, hi] with lo < hi (" + std::string(kColorRange.meaning) + ")",
+        t.fail("color_range",
+               "[lo, hi] with lo < hi (" + std::string(t.param("color_range").meaning) + ")",
                "[" + formatNumber(range->x()) + ", " + formatNumber(range->y()) + "]",
-               TableReader::useInstead(kColorRange));
+               t.useInstead("color_range"));
     }
     return std::array<double, 2>{range->x(), range->y()};
 }
 
 void readImage(const TableReader& t, Scene& scene) {
-    constexpr Param kRenderer{"renderer", "the renderer", "\"osmesa\""};
-    constexpr Param kWidth{"width", "the image width in pixels", "960"};
-    constexpr Param kHeight{"height", "the image height in pixels", "540"};
-    constexpr Param kSupersample{"supersample", "samples per pixel along each axis", "2"};
-    constexpr Param kColorBy{"color_by", "what the surface colour shows", "\"strain\""};
-    const Range pixels = Range::closed(16, 8192);
     render::RenderSettings& r = scene.render;
-    scene.renderer = RendererKind(t.choice(kRenderer, kRenderers).value_or(0));
-    r.width = int(t.integer(kWidth, pixels).value_or(r.width));
-    r.height = int(t.integer(kHeight, pixels).value_or(r.height));
-    r.supersample = int(t.integer(kSupersample, Range::closed(1, 4)).value_or(r.supersample));
-    r.colorBy = render::ColorBy(t.choice(kColorBy, kColorModes).value_or(std::size_t(r.colorBy)));
+    scene.renderer = RendererKind(t.choice("renderer").value_or(0));
+    r.width = int(t.integer("width").value_or(r.width));
+    r.height = int(t.integer("height").value_or(r.height));
+    r.supersample = int(t.integer("supersample").value_or(r.supersample));
+    r.colorBy = render::ColorBy(t.choice("color_by").value_or(std::size_t(r.colorBy)));
     r.colorRange = readColorRange(t);
 }
 
 void readPathTracing(const TableReader& t, render::PathTracing& p) {
-    constexpr Param kSpp{"spp", "path-traced samples per pixel", "16"};
-    constexpr Param kDepth{"max_depth", "the longest light path in bounces", "4"};
-    constexpr Param kMaterial{"material", "how the path tracer shades the sheet", "\"conductor\""};
-    constexpr Param kRoughness{"roughness", "the surface roughness (GGX alpha = roughness^2)",
-                               "0.35"};
-    constexpr Param kTransmission{"transmission", "the fraction of light passing through", "0.3"};
-    constexpr Param kSky{"sky", "a sky gradient instead of the constant background", "true"};
-    constexpr Param kSunRadius{"sun_radius", "the sun's angular radius in degrees", "2.0"};
-    constexpr Param kZenith{"sky_zenith", "the sky colour overhead [r, g, b]",
-                            "[0.35, 0.50, 0.80]"};
-    constexpr Param kHorizon{"sky_horizon", "the sky colour at the horizon [r, g, b]",
-                             "[0.85, 0.88, 0.92]"};
-    p.samplesPerPixel = int(t.integer(kSpp, Range::closed(1, 4096)).value_or(p.samplesPerPixel));
-    p.maxDepth = int(t.integer(kDepth, Range::closed(1, 64)).value_or(p.maxDepth));
-    p.material =
-        render::MaterialKind(t.choice(kMaterial, kMaterials).value_or(std::size_t(p.material)));
-    p.roughness = t.number(kRoughness, Range::closed(0.01, 1.0)).value_or(p.roughness);
-    p.transmission = t.number(kTransmission, Range::closed(0.0, 1.0)).value_or(p.transmission);
-    p.sky = t.boolean(kSky).value_or(p.sky);
-    p.sunAngularRadiusDegrees =
-        t.number(kSunRadius, Range::closed(0.0, 30.0)).value_or(p.sunAngularRadiusDegrees);
-    p.skyZenith = t.vec3(kZenith, Range::closed(0.0, 10.0)).value_or(p.skyZenith);
-    p.skyHorizon = t.vec3(kHorizon, Range::closed(0.0, 10.0)).value_or(p.skyHorizon);
+    p.samplesPerPixel = int(t.integer("spp").value_or(p.samplesPerPixel));
+    p.maxDepth = int(t.integer("max_depth").value_or(p.maxDepth));
+    p.material = render::MaterialKind(t.choice("material").value_or(std::size_t(p.material)));
+    p.roughness = t.number("roughness").value_or(p.roughness);
+    p.transmission = t.number("transmission").value_or(p.transmission);
+    p.sky = t.boolean("sky").value_or(p.sky);
+    p.sunAngularRadiusDegrees = t.number("sun_radius").value_or(p.sunAngularRadiusDegrees);
+    p.skyZenith = t.vec3("sky_zenith").value_or(p.skyZenith);
+    p.skyHorizon = t.vec3("sky_horizon").value_or(p.skyHorizon);
 }
 
-void readSurface(const TableReader& t, render::RenderSettings& r) {
-    constexpr Param kSurface{"surface", "how each frame becomes a surface", "\"lattice\""};
-    constexpr Param kThickness{"thickness", "the lattice surface's extruded thickness in metres",
-                               "0.002"};
-    constexpr Param kVoxel{"vdb_voxel_size", "the level set's voxel size in metres (0: dx/2)",
-                           "0.01"};
-    constexpr Param kRadius{"vdb_particle_radius", "the particle radius in metres (0: 0.75 dx)",
-                            "0.015"};
-    constexpr Param kSmoothing{"vdb_smoothing", "level-set smoothing iterations", "1"};
-    constexpr Param kAdaptivity{"vdb_adaptivity", "volumeToMesh adaptivity", "0.1"};
-    r.surface = render::SurfaceKind(t.choice(kSurface, kSurfaces).value_or(std::size_t(r.surface)));
-    r.thickness = t.number(kThickness, Range::nonNegative()).value_or(r.thickness);
-    r.vdb.voxelSize = t.number(kVoxel, Range::nonNegative()).value_or(r.vdb.voxelSize);
-    r.vdb.particleRadius = t.number(kRadius, Range::nonNegative()).value_or(r.vdb.particleRadius);
-    r.vdb.smoothingIterations =
-        int(t.integer(kSmoothing, Range::closed(0, 20)).value_or(r.vdb.smoothingIterations));
-    r.vdb.adaptivity = t.number(kAdaptivity, Range::closed(0.0, 1.0)).value_or(r.vdb.adaptivity);
+/// A voxel far below dx or a particle radius far above it makes the level set's grid huge.
+void checkVdbSizes(const TableReader& t, const render::VdbSettings& v, double dx) {
+    if (v.voxelSize != 0.0 && v.voxelSize < dx / 16) {
+        t.fail("vdb_voxel_size", "0 (dx / 2) or at least dx / 16 = " + formatNumber(dx / 16) + " m",
+               formatNumber(v.voxelSize),
+               "Use e.g. vdb_voxel_size = " + formatNumber(dx / 2) + ".");
+    }
+    if (v.particleRadius > 16 * dx) {
+        t.fail("vdb_particle_radius",
+               "0 (0.75 dx) or at most 16 dx = " + formatNumber(16 * dx) + " m",
+               formatNumber(v.particleRadius),
+               "Use e.g. vdb_particle_radius = " + formatNumber(0.75 * dx) + ".");
+    }
+}
+
+void readSurface(const TableReader& t, render::RenderSettings& r, double dx) {
+    r.surface = render::SurfaceKind(t.choice("surface").value_or(std::size_t(r.surface)));
+    r.thickness = t.number("thickness").value_or(r.thickness);
+    r.vdb.voxelSize = t.number("vdb_voxel_size").value_or(r.vdb.voxelSize);
+    r.vdb.particleRadius = t.number("vdb_particle_radius").value_or(r.vdb.particleRadius);
+    r.vdb.smoothingIterations = int(t.integer("vdb_smoothing").value_or(r.vdb.smoothingIterations));
+    r.vdb.adaptivity = t.number("vdb_adaptivity").value_or(r.vdb.adaptivity);
+    checkVdbSizes(t, r.vdb, dx);
 }
 
 void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& scene) {
-    const TableReader t = root.section({"render", "image settings", ""}, "[render]",
-                                       {"renderer",      "width",          "height",
-                                        "supersample",   "color_by",       "color_range",
-                                        "albedo",        "background",     "ground_color",
-                                        "ground",        "ground_height",  "spp",
-                                        "max_depth",     "sky_zenith",     "sky_horizon",
-                                        "material",      "roughness",      "transmission",
-                                        "sky",           "sun_radius",     "surface",
-                                        "thickness",     "vdb_voxel_size", "vdb_particle_radius",
-                                        "vdb_smoothing", "vdb_adaptivity"},
-                                       sectionFix("render"));
-    constexpr Param kAlbedo{"albedo", "the surface colour [r, g, b]", "[0.78, 0.80, 0.85]"};
-    constexpr Param kBackground{"background", "the sky colour [r, g, b]", "[0.80, 0.84, 0.90]"};
-    constexpr Param kGroundColor{"ground_color", "the ground colour [r, g, b]",
-                                 "[0.55, 0.55, 0.52]"};
-    constexpr Param kGround{"ground", "whether to draw the ground plane", "true"};
-    constexpr Param kGroundHeight{"ground_height", "the ground plane's z in metres", "-0.5"};
-    const Range unit = Range::closed(0.0, 1.0);
+    const TableReader t = root.section("render");
     render::RenderSettings& r = scene.render;
     readImage(t, scene);
     readPathTracing(t, r.pathTracing);
-    readSurface(t, r);
-    r.albedo = t.vec3(kAlbedo, unit).value_or(r.albedo);
-    r.background = t.vec3(kBackground, unit).value_or(r.background);
-    r.groundColor = t.vec3(kGroundColor, unit).value_or(r.groundColor);
-    r.ground = t.boolean(kGround).value_or(r.ground);
+    readSurface(t, r, sheet.dx);
+    r.albedo = t.vec3("albedo").value_or(r.albedo);
+    r.background = t.vec3("background").value_or(r.background);
+    r.groundColor = t.vec3("ground_color").value_or(r.groundColor);
+    r.ground = t.boolean("ground").value_or(r.ground);
     // Half the sheet's size below it: out of the way of sagging, still in the picture.
     const double belowSheet = sheet.center.z() - 0.5 * extentOf(sheet).largest;
-    r.groundHeight = t.number(kGroundHeight, Range::any()).value_or(belowSheet);
+    r.groundHeight = t.number("ground_height").value_or(belowSheet);
 }
 
 void readOutput(const TableReader& root, Scene& scene) {
-    const TableReader t = root.section({"output", "output options", ""}, "[output]",
-                                       {"stats", "export"}, sectionFix("output"));
-    constexpr Param kStats{"stats", "whether to write per-frame statistics", "true"};
-    constexpr Param kExport{"export", "per-frame files: any of \"ply\", \"obj\", \"glb\", \"vdb\"",
-                            "[\"ply\", \"vdb\"]"};
-    scene.writeStats = t.boolean(kStats).value_or(scene.writeStats);
-    const toml::node* list = t.find(kExport.key);
+    const TableReader t = root.section("output");
+    scene.writeStats = t.boolean("stats").value_or(scene.writeStats);
+    const toml::node* list = t.find("export");
     if (!list) return;
-    const toml::array* formats = list->as_array();
-    if (!formats)
-        t.fail(kExport.key, "an array of format names", scene::describeType(*list),
-               TableReader::useInstead(kExport));
-    for (const toml::node& item : *formats) {
+    const std::span<const std::string_view> formats = t.param("export").names;
+    const std::string expected = "an array of format names, " + scene::oneOf(formats);
+    const toml::array* array = list->as_array();
+    if (!array) t.fail("export", expected, scene::describeType(*list), t.useInstead("export"));
+    for (const toml::node& item : *array) {
         const auto name = item.value<std::string>();
-        const auto* hit =
-            name ? std::find(std::begin(kExportFormats), std::end(kExportFormats), *name)
-                 : std::end(kExportFormats);
-        if (hit == std::end(kExportFormats))
-            t.fail(kExport.key, "format names among \"ply\", \"obj\", \"glb\", \"vdb\"",
-                   scene::describeType(item), TableReader::useInstead(kExport));
-        scene.exports.push_back(ExportFormat(hit - std::begin(kExportFormats)));
+        const auto index = name ? names::indexOf(formats, *name) : std::nullopt;
+        if (!index) t.fail("export", expected, scene::describeType(item), t.useInstead("export"));
+        scene.exports.push_back(ExportFormat(*index));
     }
 }
 
@@ -797,10 +589,9 @@ void readOutput(const TableReader& root, Scene& scene) {
 // laws, and the SPH needs a flat sheet: a scene asking for what its solver lacks is refused,
 // not silently run without.
 void readSolver(const TableReader& root, sim::MembraneParams& p) {
-    constexpr Param kSolver{"solver", "the discretisation of the membrane", "\"fem_cst\""};
-    static constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
-                                                    "mass_spring_tp", "sph"};
-    p.solver = sim::SolverKind(root.choice(kSolver, kSolvers).value_or(std::size_t(p.solver)));
+    const scene::Param& kSolver = root.param("solver");
+    const auto& kSolvers = names::kSolvers;
+    p.solver = sim::SolverKind(root.choice(kSolver.key).value_or(std::size_t(p.solver)));
     if (p.solver == sim::SolverKind::Peridynamic) return;
     const sim::MaterialParams& m = p.material;
     std::vector<std::string> wanted;
@@ -831,10 +622,41 @@ std::string toJson(const toml::table& document) {
     return out.str();
 }
 
+/// Lattice points per dx^2: 2/sqrt(3) on the hexagonal lattice, 1 on the square one. The
+/// sphere's geodesic grid measured 2.04 (2562 particles for r = 1 m, dx = 0.1 m).
+double particlesPerCell(const sim::SheetParams& sheet) {
+    if (sheet.outline == sim::Outline::Sphere) return 2.1;
+    return sheet.lattice == sim::LatticeKind::Square ? 1.0 : 2.0 / std::sqrt(3.0);
+}
+
 }  // namespace
+
+SheetEstimate estimateSheet(const sim::SheetParams& sheet) {
+    SheetEstimate e;
+    const double density = particlesPerCell(sheet);
+    e.particles = extentOf(sheet).area / (sheet.dx * sheet.dx) * density;
+    // Lattice points within R = horizon * dx, the particle itself excluded; never fewer than the
+    // nearest-neighbour ring that every solver's mesh has.
+    const double r = sheet.horizonFactor;
+    e.bondsPerParticle = std::max(6.0, std::numbers::pi * r * r * density - 1.0);
+    e.bytes = e.particles * (SheetEstimate::kBytesPerParticle +
+                             e.bondsPerParticle * SheetEstimate::kBytesPerBondEnd);
+    return e;
+}
 
 int Scene::frameCount() const {
     return std::max(1, int(std::lround(sim.time.duration * sim.time.fps)));
+}
+
+std::string Scene::locationOf(std::string_view key) const {
+    // The key itself, else its nearest enclosing table that the file gave, else the file.
+    for (std::string path(key);; path.resize(path.rfind('.'))) {
+        if (const auto it = locations.find(path); it != locations.end() && !it->second.empty())
+            return it->second;
+        if (path.find('.') == std::string::npos) break;
+    }
+    const auto root = locations.find("");
+    return root != locations.end() && !root->second.empty() ? root->second : file.string();
 }
 
 std::filesystem::path assetsDirectory() {
@@ -845,23 +667,25 @@ std::filesystem::path assetsDirectory() {
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
     const toml::table document = scene::buildSceneDocument(file, overrides, assetsDirectory());
-    const TableReader root(document, "", "the top-level table",
-                           {"solver", "sheet", "material", "boundary", "notch", "diffusion",
-                            "forces", "time", "camera", "light", "render", "output"});
+    scene::KeyLog log;
+    const TableReader root(document, scene::sectionAt(""), "", "the top-level table", log,
+                           file.string());
     Scene s;
     s.file = file;
     s.sim.sheet = readSheet(root);
     s.sim.material = readMaterial(root);
     s.sim.boundaries = readBoundaries(root, s.sim.sheet);
-    s.sim.notches = readNotches(root);
+    s.sim.notches = readNotches(root, s.sim.sheet);
     s.sim.diffusion = readDiffusion(root, s.sim.sheet);
     readForces(root, s.sim);
     readSolver(root, s.sim);
-    s.dtLocation = readTime(root, s.sim.time);
+    readTime(root, s);
     s.render.camera = readCamera(root, s.sim.sheet);
     readLight(root, s.render);
     readRender(root, s.sim.sheet, s);
     readOutput(root, s);
+    log.reportUnused();
+    s.locations = log.locations();
     s.resolvedJson = toJson(document);
     return s;
 }

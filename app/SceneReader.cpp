@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "app/SceneError.h"
 
@@ -176,36 +177,116 @@ std::string Range::describe() const {
     return "";
 }
 
-TableReader::TableReader(const toml::table& table, std::string path, std::string title,
-                         std::initializer_list<std::string_view> allowed)
-    : table_(&table), path_(std::move(path)), title_(std::move(title)) {
-    rejectUnknownKeys(allowed);
+const Param* Section::find(std::string_view key) const {
+    const auto it =
+        std::find_if(keys.begin(), keys.end(), [&](const Param& p) { return p.key == key; });
+    return it == keys.end() ? nullptr : &*it;
 }
 
-void TableReader::rejectUnknownKeys(std::initializer_list<std::string_view> allowed) const {
-    const toml::key* first = nullptr;
-    const toml::node* firstValue = nullptr;
-    for (const auto& [key, value] : *table_) {
-        if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
-        // Report the first typo in reading order, not the map's alphabetical order.
-        if (!first || isBefore(value.source().begin, firstValue->source().begin)) {
-            first = &key;
-            firstValue = &value;
+const Section& sectionAt(std::string_view path) {
+    for (const Section& s : sceneSchema())
+        if (s.path == path) return s;
+    throw std::logic_error("no scene schema section '" + std::string(path) + "'");
+}
+
+// ---- KeyLog ----------------------------------------------------------------------------------
+
+std::size_t KeyLog::visit(const toml::table& table, const Section& section, std::string path,
+                          std::string title, std::string location) {
+    locations_.emplace(path, std::move(location));
+    entries_.push_back({&table, &section, std::move(path), std::move(title), {}});
+    return entries_.size() - 1;
+}
+
+void KeyLog::use(std::size_t entry, std::string_view key, const toml::node& value) {
+    Entry& e = entries_[entry];
+    e.used.emplace(key);
+    const std::string path = e.path.empty() ? std::string(key) : e.path + "." + std::string(key);
+    locations_.emplace(path, locationOf(value.source()));
+}
+
+std::string KeyLog::unusedMessage(const Entry& entry, const toml::key& key,
+                                  const toml::node& value) const {
+    std::vector<std::string_view> names;
+    for (const Param& p : entry.section->keys) names.push_back(p.key);
+    const bool declared = entry.section->find(key.str()) != nullptr;
+    std::string message = declared
+                              ? "key '" + std::string(key.str()) + "' in " + entry.title +
+                                    " is not used by this scene; remove it."
+                              : "unknown key '" + std::string(key.str()) + "' in " + entry.title +
+                                    "; expected one of: " + joined(names, false) + ".";
+    if (!declared) {
+        if (auto suggestion = closestMatch(key.str(), names))
+            message += " Did you mean '" + std::string(*suggestion) + "'?";
+    }
+    const toml::source_region& where = key.source().path ? key.source() : value.source();
+    return errorAt(locationOf(where), message);
+}
+
+std::optional<std::string> KeyLog::firstUnknown() const {
+    for (const Entry& e : entries_) {
+        const toml::key* first = nullptr;
+        const toml::node* firstValue = nullptr;
+        for (const auto& [key, value] : *e.table) {
+            if (e.section->find(key.str())) continue;
+            // The first typo in reading order, not the map's alphabetical order.
+            if (!first || isBefore(value.source().begin, firstValue->source().begin)) {
+                first = &key;
+                firstValue = &value;
+            }
+        }
+        if (first) return unusedMessage(e, *first, *firstValue);
+    }
+    return std::nullopt;
+}
+
+void KeyLog::reportUnused() const {
+    // Reading order, not the map's alphabetical order; every unused key, one line each.
+    std::vector<std::pair<toml::source_position, std::string>> unused;
+    for (const Entry& e : entries_) {
+        for (const auto& [key, value] : *e.table) {
+            if (e.used.contains(key.str())) continue;
+            unused.emplace_back(value.source().begin, unusedMessage(e, key, value));
         }
     }
-    if (!first) return;
-    const std::span<const std::string_view> names(allowed.begin(), allowed.size());
-    std::string message = "unknown key '" + std::string(first->str()) + "' in " + title_ +
-                          "; expected one of: " + joined(names, false) + ".";
-    if (auto suggestion = closestMatch(first->str(), names)) {
-        message += " Did you mean '" + std::string(*suggestion) + "'?";
-    }
-    const toml::source_region& where =
-        first->source().path ? first->source() : firstValue->source();
-    throw SceneError(errorAt(locationOf(where), message));
+    if (unused.empty()) return;
+    std::stable_sort(unused.begin(), unused.end(),
+                     [](const auto& a, const auto& b) { return isBefore(a.first, b.first); });
+    std::string message;
+    for (const auto& [position, line] : unused) message += (message.empty() ? "" : "\n") + line;
+    throw SceneError(message);
 }
 
-const toml::node* TableReader::find(std::string_view key) const { return table_->get(key); }
+// ---- TableReader -----------------------------------------------------------------------------
+
+TableReader::TableReader(const toml::table& table, const Section& section, std::string path,
+                         std::string title, KeyLog& log, std::string fallbackLocation)
+    : table_(&table),
+      section_(&section),
+      path_(std::move(path)),
+      title_(std::move(title)),
+      log_(&log),
+      fallbackLocation_(std::move(fallbackLocation)) {
+    entry_ = log.visit(table, section, path_, title_, location());
+}
+
+const Param& TableReader::param(std::string_view key) const {
+    if (const Param* p = section_->find(key)) return *p;
+    throw std::logic_error("key '" + std::string(key) + "' is not declared in the schema of " +
+                           title_);
+}
+
+const toml::node* TableReader::find(std::string_view key) const {
+    param(key);
+    const toml::node* node = table_->get(key);
+    if (node) log_->use(entry_, key, *node);
+    return node;
+}
+
+bool TableReader::has(std::string_view key) const {
+    param(key);
+    return table_->contains(key);
+}
 
 std::string TableReader::keyPath(std::string_view key) const {
     return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
@@ -216,7 +297,7 @@ std::string TableReader::location() const {
 }
 
 std::string TableReader::location(std::string_view key) const {
-    const toml::node* node = find(key);
+    const toml::node* node = table_->get(key);
     return node ? locationOf(node->source()) : location();
 }
 
@@ -225,7 +306,9 @@ void TableReader::fail(std::string_view key, std::string_view expected, std::str
     throw SceneError(formatError(location(key), keyPath(key), expected, found, fix));
 }
 
-void TableReader::missing(const Param& p, std::string_view constraint) const {
+void TableReader::missing(std::string_view key, std::string_view constraint) const {
+    if (auto unknown = log_->firstUnknown()) throw SceneError(*unknown);
+    const Param& p = param(key);
     std::string message = keyPath(p.key) + " is missing: expected " + std::string(p.meaning);
     if (!constraint.empty()) message += " (" + std::string(constraint) + ")";
     message += ". Add e.g. " + std::string(p.key) + " = " + std::string(p.example) + " under " +
@@ -233,139 +316,161 @@ void TableReader::missing(const Param& p, std::string_view constraint) const {
     throw SceneError(errorAt(location(), message));
 }
 
-std::string TableReader::useInstead(const Param& p) {
+std::string TableReader::useInstead(std::string_view key) const {
+    const Param& p = param(key);
     return "Use e.g. " + std::string(p.key) + " = " + std::string(p.example) + ".";
 }
 
-std::optional<double> TableReader::number(const Param& p, Range range) const {
-    const toml::node* node = find(p.key);
+std::string TableReader::expectedNumber(const Param& p, std::string_view what) const {
+    std::string expected(what);
+    if (const std::string bounds = p.range.describe(); !bounds.empty()) expected += " " + bounds;
+    return expected;
+}
+
+std::optional<double> TableReader::number(std::string_view key) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
-    std::string expected = "a number";
-    if (const std::string bounds = range.describe(); !bounds.empty()) expected += " " + bounds;
-    expected = withMeaning(expected, p.meaning);
+    const Param& p = param(key);
+    const std::string expected = withMeaning(expectedNumber(p, "a number"), p.meaning);
     const std::optional<double> value = asNumber(*node);
-    if (!value) fail(p.key, expected, describeType(*node), useInstead(p));
-    if (!std::isfinite(*value) || !range.contains(*value)) {
-        fail(p.key, expected, formatNumber(*value), useInstead(p));
+    if (!value) fail(key, expected, describeType(*node), useInstead(key));
+    if (!std::isfinite(*value) || !p.range.contains(*value)) {
+        fail(key, expected, formatNumber(*value), useInstead(key));
     }
     return value;
 }
 
-double TableReader::requiredNumber(const Param& p, Range range) const {
-    if (!has(p.key)) missing(p, range.describe());
-    return *number(p, range);
+double TableReader::requiredNumber(std::string_view key) const {
+    if (!has(key)) missing(key, param(key).range.describe());
+    return *number(key);
 }
 
-std::optional<std::int64_t> TableReader::integer(const Param& p, Range range) const {
-    const toml::node* node = find(p.key);
+std::optional<std::int64_t> TableReader::integer(std::string_view key) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
-    std::string expected = "an integer";
-    if (const std::string bounds = range.describe(); !bounds.empty()) expected += " " + bounds;
-    expected = withMeaning(expected, p.meaning);
+    const Param& p = param(key);
+    const std::string expected = withMeaning(expectedNumber(p, "an integer"), p.meaning);
     if (auto f = node->as_floating_point())
-        fail(p.key, expected, formatNumber(f->get()), useInstead(p));
+        fail(key, expected, formatNumber(f->get()), useInstead(key));
     const auto* value = node->as_integer();
-    if (!value) fail(p.key, expected, describeType(*node), useInstead(p));
-    if (!range.contains(double(value->get()))) {
-        fail(p.key, expected, std::to_string(value->get()), useInstead(p));
+    if (!value) fail(key, expected, describeType(*node), useInstead(key));
+    if (!p.range.contains(double(value->get()))) {
+        fail(key, expected, std::to_string(value->get()), useInstead(key));
     }
     return value->get();
 }
 
-std::optional<bool> TableReader::boolean(const Param& p) const {
-    const toml::node* node = find(p.key);
+std::optional<bool> TableReader::boolean(std::string_view key) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
     const auto* value = node->as_boolean();
-    if (!value)
-        fail(p.key, withMeaning("true or false", p.meaning), describeType(*node), useInstead(p));
+    if (!value) {
+        fail(key, withMeaning("true or false", param(key).meaning), describeType(*node),
+             useInstead(key));
+    }
     return value->get();
 }
 
-std::optional<std::string> TableReader::string(const Param& p) const {
-    const toml::node* node = find(p.key);
+std::optional<std::string> TableReader::string(std::string_view key) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
     const auto* value = node->as_string();
-    if (!value) fail(p.key, withMeaning("a string", p.meaning), describeType(*node), useInstead(p));
+    if (!value) {
+        fail(key, withMeaning("a string", param(key).meaning), describeType(*node),
+             useInstead(key));
+    }
     return value->get();
 }
 
-std::optional<std::size_t> TableReader::choice(const Param& p,
+std::optional<std::size_t> TableReader::choice(std::string_view key) const {
+    return choice(key, param(key).names);
+}
+
+std::optional<std::size_t> TableReader::choice(std::string_view key,
                                                std::span<const std::string_view> names) const {
-    const toml::node* node = find(p.key);
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
     const std::string expected = oneOf(names);
     const auto* value = node->as_string();
-    if (!value) fail(p.key, expected, describeType(*node), useInstead(p));
+    if (!value) fail(key, expected, describeType(*node), useInstead(key));
     const auto it = std::find(names.begin(), names.end(), value->get());
     if (it != names.end()) return std::size_t(it - names.begin());
     const auto suggestion = closestMatch(value->get(), names);
-    fail(p.key, expected, quoteText(value->get()),
-         suggestion ? "Did you mean " + quoteText(*suggestion) + "?" : useInstead(p));
+    fail(key, expected, quoteText(value->get()),
+         suggestion ? "Did you mean " + quoteText(*suggestion) + "?" : useInstead(key));
 }
 
-std::optional<std::vector<double>> TableReader::numbers(const Param& p, std::size_t count,
-                                                        Range element, bool nonZero) const {
-    const toml::node* node = find(p.key);
+std::optional<double> TableReader::numberOrWord(std::string_view key,
+                                                std::optional<double> fallback) const {
+    const toml::node* node = find(key);
+    if (!node) return fallback;
+    const Param& p = param(key);
+    const std::string_view word = p.names.front();
+    if (const auto* text = node->as_string(); text && text->get() == word) return std::nullopt;
+    if (node->is_number()) return number(key);
+    const std::string orWord = " or " + std::string(p.key) + " = " + quoteText(word) + ".";
+    fail(key,
+         expectedNumber(p, "a number") + " (" + std::string(p.meaning) + ") or " + quoteText(word),
+         describeType(*node), useInstead(key).substr(0, useInstead(key).size() - 1) + orWord);
+}
+
+std::optional<std::vector<double>> TableReader::numbers(std::string_view key, std::size_t count,
+                                                        bool nonZero) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
-    std::string expected = "an array of " + std::to_string(count) + " numbers";
-    if (const std::string bounds = element.describe(); !bounds.empty()) expected += " " + bounds;
+    const Param& p = param(key);
+    std::string expected = expectedNumber(p, "an array of " + std::to_string(count) + " numbers");
     if (nonZero) expected += ", not all zero";
     expected = withMeaning(expected, p.meaning);
 
     const toml::array* array = node->as_array();
-    if (!array || array->size() != count) fail(p.key, expected, describeType(*node), useInstead(p));
+    if (!array || array->size() != count) fail(key, expected, describeType(*node), useInstead(key));
     std::vector<double> values;
     for (const toml::node& item : *array) {
         const std::optional<double> v = asNumber(item);
-        if (!v) fail(p.key, expected, "an array containing " + describeType(item), useInstead(p));
+        if (!v) fail(key, expected, "an array containing " + describeType(item), useInstead(key));
         values.push_back(*v);
     }
     const bool inRange = std::all_of(values.begin(), values.end(), [&](double v) {
-        return std::isfinite(v) && element.contains(v);
+        return std::isfinite(v) && p.range.contains(v);
     });
     const bool allZero = std::all_of(values.begin(), values.end(), [](double v) { return v == 0; });
-    if (!inRange || (nonZero && allZero)) {
-        fail(p.key, expected, formatNumbers(values), useInstead(p));
-    }
+    if (!inRange || (nonZero && allZero))
+        fail(key, expected, formatNumbers(values), useInstead(key));
     return values;
 }
 
-std::optional<Eigen::Vector2d> TableReader::vec2(const Param& p, Range element) const {
-    const auto v = numbers(p, 2, element, false);
+std::optional<Eigen::Vector2d> TableReader::vec2(std::string_view key) const {
+    const auto v = numbers(key, 2, false);
     if (!v) return std::nullopt;
     return Eigen::Vector2d((*v)[0], (*v)[1]);
 }
 
-std::optional<Eigen::Vector3d> TableReader::vec3(const Param& p, Range element,
-                                                 bool nonZero) const {
-    const auto v = numbers(p, 3, element, nonZero);
+std::optional<Eigen::Vector3d> TableReader::vec3(std::string_view key, bool nonZero) const {
+    const auto v = numbers(key, 3, nonZero);
     if (!v) return std::nullopt;
     return Eigen::Vector3d((*v)[0], (*v)[1], (*v)[2]);
 }
 
-std::optional<std::vector<Eigen::Vector2d>> TableReader::points(const Param& p,
-                                                                std::size_t minCount,
-                                                                Range element) const {
-    const toml::node* node = find(p.key);
+std::optional<std::vector<Eigen::Vector2d>> TableReader::points(std::string_view key,
+                                                                std::size_t minCount) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
+    const Param& p = param(key);
     const std::string expected = withMeaning(
         "an array of at least " + std::to_string(minCount) + " points [x, y]", p.meaning);
     const toml::array* array = node->as_array();
-    if (!array || array->size() < minCount) {
-        fail(p.key, expected, describeType(*node), useInstead(p));
-    }
-    std::string pointExpected = "a point [x, y] of 2 numbers";
-    if (const std::string bounds = element.describe(); !bounds.empty()) {
-        pointExpected += " " + bounds;
-    }
-    pointExpected = withMeaning(pointExpected, p.meaning);
+    if (!array || array->size() < minCount)
+        fail(key, expected, describeType(*node), useInstead(key));
+    const std::string pointExpected =
+        withMeaning(expectedNumber(p, "a point [x, y] of 2 numbers"), p.meaning);
 
     std::vector<Eigen::Vector2d> result;
     for (const toml::node& item : *array) {
-        const std::string itemKey = keyPath(p.key) + "." + std::to_string(result.size());
+        const std::string itemKey = keyPath(key) + "." + std::to_string(result.size());
         const auto failItem = [&](const std::string& found) {
             throw SceneError(formatError(locationOf(item.source()), itemKey, pointExpected, found,
-                                         useInstead(p)));
+                                         useInstead(key)));
         };
         const toml::array* point = item.as_array();
         if (!point || point->size() != 2) failItem(describeType(item));
@@ -376,33 +481,59 @@ std::optional<std::vector<Eigen::Vector2d>> TableReader::points(const Param& p,
             values.push_back(*v);
         }
         for (const double v : values) {
-            if (!std::isfinite(v) || !element.contains(v)) failItem(formatNumbers(values));
+            if (!std::isfinite(v) || !p.range.contains(v)) failItem(formatNumbers(values));
         }
         result.emplace_back(values[0], values[1]);
     }
     return result;
 }
 
-std::optional<TableReader> TableReader::subtable(const Param& p, std::string title,
-                                                 std::initializer_list<std::string_view> allowed,
-                                                 std::string_view fix) const {
-    const toml::node* node = find(p.key);
+std::optional<TableReader> TableReader::subtable(std::string_view key) const {
+    const toml::node* node = find(key);
     if (!node) return std::nullopt;
+    const Param& p = param(key);
     const toml::table* child = node->as_table();
-    if (!child) fail(p.key, withMeaning("a table", p.meaning), describeType(*node), fix);
-    TableReader reader(*child, keyPath(p.key), std::move(title), allowed);
-    reader.fallbackLocation_ = location();
-    return reader;
+    if (!child) {
+        fail(key, withMeaning("a table", p.meaning), describeType(*node),
+             p.example.empty()
+                 ? "Write it as a table: a [" + keyPath(key) + "] header followed by its keys."
+                 : useInstead(key));
+    }
+    return childReader(*child, key);
 }
 
-TableReader TableReader::section(const Param& p, std::string title,
-                                 std::initializer_list<std::string_view> allowed,
-                                 std::string_view fix) const {
-    if (auto child = subtable(p, title, allowed, fix)) return *child;
+TableReader TableReader::section(std::string_view key) const {
+    if (auto child = subtable(key)) return *child;
     static const toml::table kEmpty;
-    TableReader empty(kEmpty, keyPath(p.key), std::move(title), allowed);
-    empty.fallbackLocation_ = location();
-    return empty;
+    return childReader(kEmpty, key);
+}
+
+TableReader TableReader::childReader(const toml::table& table, std::string_view key) const {
+    const Section& section = sectionAt(param(key).section);
+    // "[sheet]" names a section; an inline table such as a box is named by its path.
+    const std::string title =
+        section.title.starts_with("[") ? std::string(section.title) : keyPath(key);
+    return TableReader(table, section, keyPath(key), title, *log_, location());
+}
+
+std::vector<TableReader> TableReader::entries(std::string_view key) const {
+    const toml::node* node = find(key);
+    if (!node) return {};
+    const Section& section = sectionAt(param(key).section);
+    const std::string header = "[[" + keyPath(key) + "]]";
+    const std::string expected = "an array of tables written as " + header;
+    const std::string fix = "Give each entry its own " + header + " header.";
+    const toml::array* array = node->as_array();
+    if (!array) fail(key, expected, describeType(*node), fix);
+    std::vector<TableReader> tables;
+    for (const toml::node& item : *array) {
+        const toml::table* table = item.as_table();
+        if (!table) fail(key, expected, "an array containing " + describeType(item), fix);
+        const std::string index = std::to_string(tables.size());
+        tables.emplace_back(*table, section, keyPath(key) + "." + index, header + " entry " + index,
+                            *log_, location());
+    }
+    return tables;
 }
 
 }  // namespace rend::scene

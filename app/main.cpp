@@ -14,6 +14,7 @@
 #include "app/Pipeline.h"
 #include "app/Scene.h"
 #include "app/SceneError.h"
+#include "app/SceneNames.h"
 #include "render/Versions.h"
 
 namespace {
@@ -33,12 +34,30 @@ int checkCommand(const std::string& file, const std::vector<std::string>& sets) 
     const rend::Scene scene = rend::loadScene(file, sets);
     const rend::sim::Membrane membrane = rend::prepareMembrane(scene);
     const auto [substeps, dt] = rend::substepsPerFrame(membrane.timeStep(), scene.sim.time.fps);
+    const rend::RunEstimate estimate = rend::estimateRun(scene, membrane);
+    const rend::SheetEstimate sheet = rend::estimateSheet(scene.sim.sheet);
     std::printf(
         "%s: ok\n  %d particles, %zu bonds, dt %.4g s (stable limit %.4g s), "
-        "%d steps per frame, %d frames\n",
+        "%d steps per frame, %d frames\n"
+        "  estimated memory %.3g GB (%.3g particles x (%g B + %.3g bonds x %g B))\n"
+        "  estimated cost: %s\n",
         file.c_str(), membrane.particleCount(), membrane.bondCount(), dt, membrane.stableTimeStep(),
-        substeps, scene.frameCount());
+        substeps, scene.frameCount(), sheet.bytes / 1e9, sheet.particles,
+        rend::SheetEstimate::kBytesPerParticle, sheet.bondsPerParticle,
+        rend::SheetEstimate::kBytesPerBondEnd, rend::describeEstimate(estimate).c_str());
     return 0;
+}
+
+/// "a, b, c" for messages.
+std::string namesText(std::span<const std::string_view> names) {
+    std::string text;
+    for (std::string_view name : names) text += (text.empty() ? "" : ", ") + std::string(name);
+    return text;
+}
+
+/// CLI11's IsMember takes a container of strings.
+std::vector<std::string> members(std::span<const std::string_view> names) {
+    return {names.begin(), names.end()};
 }
 
 struct RunArgs {
@@ -49,24 +68,18 @@ struct RunArgs {
 };
 
 std::vector<rend::ExportFormat> parseExports(const std::string& text) {
-    static const std::pair<const char*, rend::ExportFormat> kNames[] = {
-        {"ply", rend::ExportFormat::Ply},
-        {"obj", rend::ExportFormat::Obj},
-        {"glb", rend::ExportFormat::Glb},
-        {"vdb", rend::ExportFormat::Vdb}};
     std::vector<rend::ExportFormat> formats;
     std::size_t start = 0;
     while (start <= text.size()) {
         const std::size_t end = std::min(text.find(',', start), text.size());
         const std::string name = text.substr(start, end - start);
-        const auto* hit = std::find_if(std::begin(kNames), std::end(kNames),
-                                       [&](const auto& n) { return name == n.first; });
-        if (hit == std::end(kNames))
+        const auto index = rend::names::indexOf(rend::names::kExportFormats, name);
+        if (!index)
             throw rend::SceneError("--export " + text +
-                                   ": error: expected a comma-separated list of "
-                                   "ply, obj, glb, vdb, found \"" +
-                                   name + "\". Use e.g. --export ply,vdb.");
-        formats.push_back(hit->second);
+                                   ": error: expected a comma-separated list of " +
+                                   namesText(rend::names::kExportFormats) + ", found \"" + name +
+                                   "\". Use e.g. --export ply,vdb.");
+        formats.push_back(rend::ExportFormat(*index));
         start = end + 1;
     }
     return formats;
@@ -74,12 +87,11 @@ std::vector<rend::ExportFormat> parseExports(const std::string& text) {
 
 // Command-line choices override the scene's, after it has been validated.
 void applyOverrides(const RunArgs& a, rend::Scene& scene) {
-    if (a.renderer == "none") scene.renderer = rend::RendererKind::None;
-    if (a.renderer == "osmesa") scene.renderer = rend::RendererKind::Osmesa;
-    if (a.renderer == "embree") scene.renderer = rend::RendererKind::Embree;
-    if (a.surface == "lattice") scene.render.surface = rend::render::SurfaceKind::Lattice;
-    if (a.surface == "splat") scene.render.surface = rend::render::SurfaceKind::Splat;
-    if (a.surface == "vdb") scene.render.surface = rend::render::SurfaceKind::Vdb;
+    using rend::names::indexOf;
+    if (auto k = indexOf(rend::names::kRenderers, a.renderer))
+        scene.renderer = rend::RendererKind(*k);
+    if (auto k = indexOf(rend::names::kSurfaces, a.surface))
+        scene.render.surface = rend::render::SurfaceKind(*k);
     if (!a.exports.empty()) scene.exports = parseExports(a.exports);
     if (a.spp > 0) scene.render.pathTracing.samplesPerPixel = a.spp;
 }
@@ -131,9 +143,9 @@ int main(int argc, char** argv) {
     runCmd->add_option("--frames", run.frames, "Frames to write: N or FIRST-LAST")
         ->check(nonEmpty("N or FIRST-LAST", "--frames 1-10 (or leave --frames out for all)"));
     runCmd->add_option("--renderer", run.renderer, "Override [render] renderer")
-        ->check(CLI::IsMember({"osmesa", "embree", "none"}));
+        ->check(CLI::IsMember(members(rend::names::kRenderers)));
     runCmd->add_option("--surface", run.surface, "Override [render] surface")
-        ->check(CLI::IsMember({"lattice", "splat", "vdb"}));
+        ->check(CLI::IsMember(members(rend::names::kSurfaces)));
     runCmd->add_option("--export", run.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
         ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
     runCmd->add_option("--spp", run.spp, "Path-traced samples per pixel (embree)")

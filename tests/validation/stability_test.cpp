@@ -76,7 +76,7 @@ void jitter(Membrane& m, double amplitude, std::uint64_t seed) {
 Scene tinyScene(double E, double rho, double dx, double speed, int cells = 11) {
     Scene s;
     s.file = "stability_test";
-    s.dtLocation = "stability_test:time.dt";
+    s.locations["time.dt"] = "stability_test:time.dt";
     s.renderer = RendererKind::None;
     MembraneParams& p = s.sim;
     p.sheet.size = {cells * dx, cells * dx};

@@ -1,0 +1,40 @@
+#pragma once
+// One name table per enum that a scene file or the command line spells out. Each table follows
+// its enum's order, so an index converts straight to the enum; the loader, `rend run`'s options
+// and the README's scene table all read these.
+
+#include <optional>
+#include <span>
+#include <string_view>
+
+namespace rend::names {
+
+inline constexpr std::string_view kShapes[] = {"rectangle", "disc", "sphere"};  // sim::Outline
+inline constexpr std::string_view kLattices[] = {"hexagonal", "square"};
+inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
+inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
+inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper"};
+inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
+inline constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
+inline constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};
+/// sim::SolverKind; the solver registry takes these over.
+inline constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
+                                                "mass_spring_tp", "sph"};
+inline constexpr std::string_view kRenderers[] = {"osmesa", "none", "embree"};
+inline constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
+inline constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};
+inline constexpr std::string_view kExportFormats[] = {"ply", "obj", "glb", "vdb"};
+inline constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
+/// The words that stand for "no number": dt = "auto", fracture_energy = "none".
+inline constexpr std::string_view kAuto[] = {"auto"};
+inline constexpr std::string_view kNone[] = {"none"};
+
+/// Index of `name` in `table`, if it is there.
+inline std::optional<std::size_t> indexOf(std::span<const std::string_view> table,
+                                          std::string_view name) {
+    for (std::size_t k = 0; k < table.size(); ++k)
+        if (table[k] == name) return k;
+    return std::nullopt;
+}
+
+}  // namespace rend::names

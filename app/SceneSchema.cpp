@@ -1,0 +1,462 @@
+// The scene schema: every key of every table, declared once with its type, range, default,
+// meaning and an example. SceneLoader.cpp reads by key name through TableReader, which refuses
+// any key not declared here; the README's scene-file table is schemaMarkdown()'s output.
+//
+// Ranges are physical sanity bounds, upper ones included, so that no product of accepted values
+// (substeps, frames, particle counts, blow-up limits) can overflow: speeds stay below 1 km/s,
+// accelerations below 1000 g, lengths within 10 km, times within 1e6 s.
+
+#include <string>
+
+#include "app/SceneNames.h"
+#include "app/SceneReader.h"
+
+namespace rend::scene {
+namespace {
+
+using T = ValueType;
+constexpr Range closed(double lo, double hi) { return Range::closed(lo, hi); }
+constexpr Range positive(double hi) { return Range::openClosed(0.0, hi); }
+
+constexpr Range kLength = closed(-1e4, 1e4);  ///< coordinates in metres
+constexpr Range kUnit = closed(0.0, 1.0);
+constexpr Range kTime = closed(0.0, 1e6);  ///< seconds
+constexpr Range kTheta = closed(-1e6, 1e6);
+constexpr Range kRate = closed(-1e9, 1e9);
+constexpr Range kSeed = closed(0.0, 9e18);  ///< below 2^63
+
+constexpr Param kRoot[] = {
+    {"solver",
+     T::Choice,
+     {},
+     "\"peridynamic\"",
+     "the discretisation of the membrane (see Solvers)",
+     "\"fem_cst\"",
+     names::kSolvers},
+    {"sheet", T::Table, {}, "", "the membrane's outline and lattice", "", {}, "sheet"},
+    {"material", T::Table, {}, "", "the membrane's material", "", {}, "material"},
+    {"boundary", T::Tables, {}, "", "a boundary condition", "", {}, "boundary"},
+    {"notch", T::Tables, {}, "", "a pre-cut crack", "", {}, "notch"},
+    {"diffusion",
+     T::Table,
+     {},
+     "",
+     "the diffusive quantity theta (acid, heat, moisture)",
+     "",
+     {},
+     "diffusion"},
+    {"forces", T::Table, {}, "", "external forces", "", {}, "forces"},
+    {"time", T::Table, {}, "", "time stepping", "", {}, "time"},
+    {"camera", T::Table, {}, "", "the camera", "", {}, "camera"},
+    {"light", T::Table, {}, "", "the lighting", "", {}, "light"},
+    {"render", T::Table, {}, "", "image settings", "", {}, "render"},
+    {"output", T::Table, {}, "", "output options", "", {}, "output"},
+};
+
+constexpr Param kSheet[] = {
+    {"shape",
+     T::Choice,
+     {},
+     "\"rectangle\"",
+     "the sheet's outline (sphere: closed, for inflation)",
+     "\"rectangle\"",
+     names::kShapes},
+    {"size", T::Vec2, positive(1e4), "required for a rectangle",
+     "the rectangle's extent [x, y] in metres", "[2.0, 2.0]"},
+    {"radius", T::Number, positive(1e4), "required for a disc or sphere",
+     "the disc or sphere radius in metres", "1.0"},
+    {"center", T::Vec3, kLength, "[0, 0, 0]",
+     "the sheet's centre [x, y, z] in metres; at rest it lies in the plane z = center.z",
+     "[0.0, 0.0, 0.0]"},
+    {"lattice",
+     T::Choice,
+     {},
+     "\"hexagonal\"",
+     "the particle arrangement",
+     "\"hexagonal\"",
+     names::kLattices},
+    {"dx", T::Number, closed(1e-6, 1e3), "required", "the particle spacing in metres", "0.02"},
+    {"horizon", T::Number, Range::openClosed(1.0, 6.0), "1.5",
+     "the bond cutoff R in units of dx (the paper's is 1.5)", "1.5"},
+    {"thickness", T::Number, closed(1e-9, 10.0), "0.001", "the membrane thickness h in metres",
+     "0.001"},
+    {"perturbation", T::Number, closed(0.0, 1e4), "0",
+     "the amplitude of a seeded out-of-plane jitter at rest in metres", "1e-4"},
+    {"seed", T::Integer, kSeed, "1", "the jitter's random seed", "7"},
+};
+
+constexpr Param kMaterial[] = {
+    {"preset",
+     T::String,
+     {},
+     "none",
+     "a file assets/materials/NAME.toml whose keys apply unless given here",
+     "\"stretch_sheet\""},
+    {"name", T::String, {}, "the preset, else \"custom\"", "the material's name", "\"rubber\""},
+    {"E", T::Number, closed(1e-3, 1e13), "required", "Young's modulus in Pa", "2e4"},
+    {"poisson", T::Number, Range::open(-1.0, 0.5), "0.3",
+     "Poisson's ratio (bond-based peridynamics fixes 1/3 unless micromodulus = \"paper\")", "0.3"},
+    {"density", T::Number, closed(1e-3, 1e6), "required", "the density in kg/m^3", "5000"},
+    {"micromodulus",
+     T::Choice,
+     {},
+     "\"calibrated\"",
+     "how the bond stiffness is derived",
+     "\"calibrated\"",
+     names::kMicromoduli},
+    {"law",
+     T::Choice,
+     {},
+     "\"linear\"",
+     "the bond law: eq. 18, 19 or 20 of the membrane paper",
+     "\"linear\"",
+     names::kLaws},
+    {"power_ratio", T::Number, closed(-1e6, 0.0), "0", "c*/c of the power law, eq. 19", "-0.1"},
+    {"power_exponent", T::Number, Range::openClosed(1.0, 100.0), "4",
+     "the exponent n of the power law, eq. 19", "4"},
+    {"yield_strain", T::Number, positive(10.0), "1e-4", "the elastic limit eta0 of eqs. 20 and 27",
+     "1e-4"},
+    {"softening", T::Number, positive(1e6), "1", "beta of eqs. 20 and 27, the post-yield decay",
+     "1.0"},
+    {"fracture_energy", T::NumberOrWord, positive(1e9), "\"none\" (unbreakable)",
+     "the fracture energy G_f in J/m^2", "11.3", names::kNone},
+    {"critical_stretch",
+     T::Choice,
+     {},
+     "\"calibrated\"",
+     "how the critical stretch follows from G_f (\"paper\": eq. 28 as printed)",
+     "\"calibrated\"",
+     names::kCriticalStretches},
+    {"strength_loss", T::Number, closed(0.0, 1e6), "0",
+     "the critical stretch lost per unit theta (acid, moisture)", "0.6"},
+    {"surface_correction",
+     T::Boolean,
+     {},
+     "false",
+     "whether edge particles are stiffened to the interior's",
+     "true"},
+    {"capacity", T::Number, closed(1e-9, 1e9), "1", "the diffusive capacity C of eq. 25", "1.0"},
+    {"conductivity", T::Number, closed(0.0, 1e9), "0 (no diffusion)",
+     "the coefficient of diffusion k of eq. 25", "0.01"},
+    {"expansion", T::Number, closed(-10.0, 10.0), "0", "alpha, the strain per unit theta", "0.3"},
+    {"stiffness_loss", T::Number, closed(0.0, 1e6), "0", "the stiffness lost per unit theta",
+     "0.5"},
+};
+
+// The region keys of [[boundary]] and [[diffusion.edge]].
+constexpr Param kEdge{"edge",
+                      T::Choice,
+                      {},
+                      "required unless box",
+                      "a strip along a side of the sheet's rest bounding box",
+                      "\"left\"",
+                      names::kEdges};
+constexpr Param kDepth{"depth", T::Number, positive(1e4), "1", "the strip width in units of dx",
+                       "1.0"};
+constexpr Param kBoundaryBox{"box",
+                             T::Table,
+                             {},
+                             "instead of edge",
+                             "a region's corners in rest coordinates",
+                             "{ min = [-1.0, -1.0], max = [-0.9, 1.0] }",
+                             {},
+                             "boundary.box"};
+
+constexpr Param kBoundary[] = {
+    {"type",
+     T::Choice,
+     {},
+     "required",
+     "the kind of condition",
+     "\"velocity\"",
+     names::kBoundaryTypes},
+    kEdge,
+    kDepth,
+    kBoundaryBox,
+    {"velocity", T::Vec3, closed(-1e3, 1e3), "required for type = \"velocity\"",
+     "the prescribed velocity [x, y, z] in m/s", "[0.15, 0.0, 0.0]"},
+    {"ramp", T::Number, kTime, "0", "seconds to reach full speed from rest", "0.5"},
+};
+
+constexpr Param kBox[] = {
+    {"min", T::Vec2, kLength, "required", "the box's lower corner [x, y] in metres",
+     "[-1.0, -1.0]"},
+    {"max", T::Vec2, kLength, "required", "the box's upper corner [x, y] in metres", "[-0.9, 1.0]"},
+};
+
+constexpr Param kNotch[] = {
+    {"points", T::Points, kLength, "required",
+     "the notch polyline in rest coordinates, metres; bonds crossing it break at set-up",
+     "[[-1.0, 0.0], [-0.6, 0.0]]"},
+};
+
+constexpr Param kDiffusion[] = {
+    {"initial", T::Number, kTheta, "0", "theta everywhere at t = 0", "0.0"},
+    {"spot", T::Tables, {}, "", "a source of theta", "", {}, "diffusion.spot"},
+    {"scatter",
+     T::Tables,
+     {},
+     "",
+     "seeded spots or a spray of droplets",
+     "",
+     {},
+     "diffusion.scatter"},
+    {"edge", T::Tables, {}, "", "theta held on a region", "", {}, "diffusion.edge"},
+};
+
+// The source keys of [[diffusion.spot]] and [[diffusion.scatter]].
+constexpr Param kSourceRadius{
+    "radius", T::Number, positive(1e4), "required", "the source's radius in metres", "0.05"};
+constexpr Param kSourceRate{
+    "rate", T::Number, kRate, "required", "theta added per second inside it (negative: a sink)",
+    "1.0"};
+constexpr Param kSourceStart{"start", T::Number, kTime, "0", "the time in seconds it switches on",
+                             "0.0"};
+constexpr Param kSourceDuration{
+    "duration", T::Number, positive(1e6), "forever", "how many seconds it stays on", "2.0"};
+
+constexpr Param kSpot[] = {
+    {"center", T::Vec2, kLength, "required", "the spot's centre [x, y] in rest coordinates, metres",
+     "[0.0, 0.0]"},
+    kSourceRadius,
+    kSourceRate,
+    kSourceStart,
+    kSourceDuration,
+};
+
+constexpr Param kScatter[] = {
+    {"count", T::Integer, closed(1, 1e4), "required", "how many spots or droplets", "20"},
+    kSourceRadius,
+    kSourceRate,
+    kSourceStart,
+    {"spread", T::Number, kTime, "0", "seconds over which droplets are emitted; 0: all at once",
+     "3.0"},
+    kSourceDuration,
+    {"seed", T::Integer, kSeed, "1", "the placement's random seed", "1"},
+};
+
+constexpr Param kDiffusionEdge[] = {
+    kEdge,
+    kDepth,
+    {"box",
+     T::Table,
+     {},
+     "instead of edge",
+     "a region's corners in rest coordinates",
+     "{ min = [-1.0, -1.0], max = [-0.9, 1.0] }",
+     {},
+     "diffusion.edge.box"},
+    {"value", T::Number, kTheta, "required", "the theta held on the region", "1.0"},
+};
+
+constexpr Param kForces[] = {
+    {"gravity", T::Vec3, closed(-1e4, 1e4), "[0, 0, 0]",
+     "the gravitational acceleration [x, y, z] in m/s^2", "[0.0, 0.0, -9.81]"},
+    {"damping", T::Number, closed(0.0, 1e6), "0", "the mass-proportional velocity damping in 1/s",
+     "0.1"},
+    {"pressure", T::Number, kRate, "0", "a uniform follower pressure on the +z side in Pa",
+     "100.0"},
+};
+
+constexpr Param kTimeKeys[] = {
+    {"dt", T::NumberOrWord, positive(10.0), "\"auto\" (safety x the stable bound)",
+     "the time step in seconds", "1e-4", names::kAuto},
+    {"safety", T::Number, Range::openClosed(0.0, 1.0), "0.8",
+     "the fraction of the stable time step used by dt = \"auto\"", "0.8"},
+    {"duration", T::Number, positive(1e6), "5", "the simulated time in seconds", "5.0"},
+    {"fps", T::Number, closed(1e-3, 1e4), "24", "the output frames per simulated second", "24"},
+    {"allow_unstable",
+     T::Boolean,
+     {},
+     "false",
+     "expert: accept a dt above the stable bound (the blow-up guard still runs)",
+     "false"},
+    {"allow_slow",
+     T::Boolean,
+     {},
+     "false",
+     "run even when the estimated cost is beyond the limit",
+     "true"},
+    {"integrator",
+     T::Choice,
+     {},
+     "\"symplectic_euler\"",
+     "the explicit scheme (eq. 26)",
+     "\"velocity_verlet\"",
+     names::kIntegrators},
+};
+
+constexpr Param kCamera[] = {
+    {"position", T::Vec3, kLength, "frames the sheet from the front and above",
+     "the camera position [x, y, z] in metres", "[0.0, -4.0, 3.0]"},
+    {"look_at", T::Vec3, kLength, "the sheet's centre",
+     "the point the camera aims at [x, y, z] in metres", "[0.0, 0.0, 0.0]"},
+    {"up", T::Vec3, kLength, "[0, 0, 1]", "the camera's up direction [x, y, z]", "[0.0, 0.0, 1.0]"},
+    {"fov", T::Number, Range::open(1.0, 170.0), "40", "the vertical field of view in degrees",
+     "40"},
+};
+
+constexpr Param kLight[] = {
+    {"direction", T::Vec3, kLength, "[-0.4, -0.5, 1]", "from the surface towards the sun [x, y, z]",
+     "[-0.4, -0.5, 1.0]"},
+    {"color", T::Vec3, closed(0.0, 1e3), "[1, 1, 1]", "the sun's colour [r, g, b]",
+     "[1.0, 1.0, 1.0]"},
+    {"intensity", T::Number, closed(0.0, 1e3), "0.85", "the sun's strength", "0.85"},
+    {"ambient", T::Number, kUnit, "0.25", "the ambient light level", "0.25"},
+};
+
+constexpr Param kRender[] = {
+    {"renderer", T::Choice, {}, "\"osmesa\"", "the renderer", "\"osmesa\"", names::kRenderers},
+    {"width", T::Integer, closed(16, 8192), "960", "the image width in pixels", "960"},
+    {"height", T::Integer, closed(16, 8192), "540", "the image height in pixels", "540"},
+    {"supersample", T::Integer, closed(1, 4), "2", "samples per pixel along each axis", "2"},
+    {"color_by",
+     T::Choice,
+     {},
+     "\"none\"",
+     "what the surface colour shows (strain: mean bond strain; theta: light to dark red)",
+     "\"strain\"",
+     names::kColorModes},
+    {"color_range", T::Vec2, closed(-1e9, 1e9), "0 .. each frame's maximum",
+     "the values mapped to the ends of the colour map", "[0.0, 0.6]"},
+    {"albedo", T::Vec3, kUnit, "[0.78, 0.80, 0.85]", "the surface colour [r, g, b], linear",
+     "[0.78, 0.80, 0.85]"},
+    {"background", T::Vec3, kUnit, "[0.80, 0.84, 0.90]", "the sky colour [r, g, b], linear",
+     "[0.80, 0.84, 0.90]"},
+    {"ground_color", T::Vec3, kUnit, "[0.55, 0.55, 0.52]", "the ground colour [r, g, b], linear",
+     "[0.55, 0.55, 0.52]"},
+    {"ground", T::Boolean, {}, "true", "whether to draw the ground plane", "true"},
+    {"ground_height", T::Number, kLength, "half the sheet's size below it",
+     "the ground plane's z in metres", "-0.5"},
+    {"spp", T::Integer, closed(1, 4096), "16", "path-traced samples per pixel (embree)", "16"},
+    {"max_depth", T::Integer, closed(1, 64), "4", "the longest light path in bounces (embree)",
+     "4"},
+    {"material",
+     T::Choice,
+     {},
+     "\"diffuse\"",
+     "how the path tracer shades the sheet",
+     "\"conductor\"",
+     names::kMaterials},
+    {"roughness", T::Number, closed(0.01, 1.0), "0.35",
+     "the surface roughness (GGX alpha = roughness^2)", "0.35"},
+    {"transmission", T::Number, kUnit, "0", "the fraction of light passing through", "0.3"},
+    {"sky", T::Boolean, {}, "true", "a sky gradient instead of the constant background", "true"},
+    {"sun_radius", T::Number, closed(0.0, 30.0), "2", "the sun's angular radius in degrees", "2.0"},
+    {"sky_zenith", T::Vec3, closed(0.0, 10.0), "[0.35, 0.50, 0.80]",
+     "the sky colour overhead [r, g, b]", "[0.35, 0.50, 0.80]"},
+    {"sky_horizon", T::Vec3, closed(0.0, 10.0), "[0.85, 0.88, 0.92]",
+     "the sky colour at the horizon [r, g, b]", "[0.85, 0.88, 0.92]"},
+    {"surface",
+     T::Choice,
+     {},
+     "\"lattice\"",
+     "how each frame becomes a surface",
+     "\"lattice\"",
+     names::kSurfaces},
+    {"thickness", T::Number, closed(0.0, 100.0), "0",
+     "the lattice surface's extruded thickness in metres", "0.002"},
+    {"vdb_voxel_size", T::Number, closed(0.0, 1e3), "0 (dx / 2)",
+     "the level set's voxel size in metres", "0.01"},
+    {"vdb_particle_radius", T::Number, closed(0.0, 1e3), "0 (0.75 dx)",
+     "the particle radius in metres", "0.015"},
+    {"vdb_smoothing", T::Integer, closed(0, 20), "1", "level-set smoothing iterations", "1"},
+    {"vdb_adaptivity", T::Number, kUnit, "0.1", "volumeToMesh adaptivity", "0.1"},
+};
+
+constexpr Param kOutput[] = {
+    {"stats", T::Boolean, {}, "true", "whether to write stats.csv", "true"},
+    {"export",
+     T::ChoiceList,
+     {},
+     "[]",
+     "per-frame files besides the PNG",
+     "[\"ply\", \"vdb\"]",
+     names::kExportFormats},
+};
+
+constexpr Section kSchema[] = {
+    {"", "the top-level table", kRoot},
+    {"sheet", "[sheet]", kSheet},
+    {"material", "[material]", kMaterial},
+    {"boundary", "[[boundary]]", kBoundary},
+    {"boundary.box", "box", kBox},
+    {"notch", "[[notch]]", kNotch},
+    {"diffusion", "[diffusion]", kDiffusion},
+    {"diffusion.spot", "[[diffusion.spot]]", kSpot},
+    {"diffusion.scatter", "[[diffusion.scatter]]", kScatter},
+    {"diffusion.edge", "[[diffusion.edge]]", kDiffusionEdge},
+    {"diffusion.edge.box", "box", kBox},
+    {"forces", "[forces]", kForces},
+    {"time", "[time]", kTimeKeys},
+    {"camera", "[camera]", kCamera},
+    {"light", "[light]", kLight},
+    {"render", "[render]", kRender},
+    {"output", "[output]", kOutput},
+};
+
+std::string quotedNames(std::span<const std::string_view> names) {
+    std::string out;
+    for (std::size_t k = 0; k < names.size(); ++k) {
+        out += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ");
+        out += "`\"" + std::string(names[k]) + "\"`";
+    }
+    return out;
+}
+
+std::string typeText(const Param& p) {
+    const std::string bounds = p.range.describe();
+    const std::string within = bounds.empty() ? "" : " " + bounds;
+    switch (p.type) {
+        case T::Number:
+            return "number" + within;
+        case T::Integer:
+            return "integer" + within;
+        case T::Boolean:
+            return "`true` or `false`";
+        case T::String:
+            return "string";
+        case T::Choice:
+            return quotedNames(p.names);
+        case T::NumberOrWord:
+            return "number" + within + " or `\"" + std::string(p.names[0]) + "\"`";
+        case T::Vec2:
+            return "[x, y]" + within;
+        case T::Vec3:
+            return "[x, y, z]" + within;
+        case T::Points:
+            return "[[x, y], ...]" + within;
+        case T::ChoiceList:
+            return "array of " + quotedNames(p.names);
+        case T::Table:
+        case T::Tables:
+            break;
+    }
+    return "table";
+}
+
+void appendRows(const Section& section, const std::string& prefix, std::string& out) {
+    for (const Param& p : section.keys) {
+        const std::string key = prefix + std::string(p.key);
+        if (p.type == T::Table) {
+            appendRows(sectionAt(p.section), key + ".", out);
+        } else if (p.type == T::Tables) {
+            appendRows(sectionAt(p.section), key + "[].", out);
+        } else {
+            out += "| `" + key + "` | " + typeText(p) + " | " + std::string(p.fallback) + " | " +
+                   std::string(p.meaning) + " |\n";
+        }
+    }
+}
+
+}  // namespace
+
+std::span<const Section> sceneSchema() { return kSchema; }
+
+std::string schemaMarkdown() {
+    std::string out = "| key | value | default | meaning |\n|---|---|---|---|\n";
+    appendRows(kSchema[0], "", out);
+    return out;
+}
+
+}  // namespace rend::scene

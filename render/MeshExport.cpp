@@ -177,8 +177,8 @@ public:
         const std::size_t base = origin == aiOrigin_SET   ? 0
                                  : origin == aiOrigin_CUR ? position_
                                                           : bytes_.size();
-        if (base + offset > bytes_.size()) return aiReturn_FAILURE;
-        position_ = base + offset;
+        position_ = base + offset;  // past the end, as in a file: the gap reads as zeros
+        if (position_ > bytes_.size()) bytes_.resize(position_);
         return aiReturn_SUCCESS;
     }
     size_t Tell() const override { return position_; }

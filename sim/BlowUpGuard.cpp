@@ -115,6 +115,7 @@ void BlowUpGuard::check(const State& state, const std::function<double()>& total
     const double allowed = budget_ + thermalEnergy_ * s.maxAbsTheta * s.maxAbsTheta;
     if (growingSteps_ < kGrowthSteps || !(s.kinetic > kBudgetFactor * allowed)) return;
     std::ostringstream why;
+    why.precision(3);
     why << "the kinetic energy grew " << std::pow(growthProduct_, 1.0 / growingSteps_)
         << "x per step over the last " << growingSteps_ << " steps to " << s.kinetic << " J, "
         << s.kinetic / allowed

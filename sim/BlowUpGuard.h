@@ -83,11 +83,13 @@ public:
     Sample sample(const State& state) const;
 
 private:
+    void sampleBlock(const State& state, int begin, int end, Sample& out) const;
     [[noreturn]] void report(const State& state, const Sample& s, const std::string& why) const;
     void addWork(const State& state, const Sample& s);
 
     double speedLimit_ = kLightSpeed;
     Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
+    bool hasGravity_ = false;
     double pressureArea_ = 0.0;   ///< |p| times four times the rest area (stretched sheet) [N]
     double thermalEnergy_ = 0.0;  ///< E alpha^2 V: energy per theta^2 expansion can store [J]
     double floor_ = 0.0;          ///< budget never below this [J]

@@ -232,6 +232,20 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         folder.wrote({"stats.csv"});
         writeRunJson(status, folder.finish());
     };
+    // A write failed (a full disk): keep what is complete and mark the run failed, as far as the
+    // disk still allows. When even run.json cannot be written it keeps saying "running".
+    auto finishAfterFailure = [&] {
+        try {
+            stats.finish();
+            folder.wrote({"stats.csv"});
+        } catch (const std::exception&) {
+        }
+        const std::vector<std::string> files = folder.finish();
+        try {
+            writeRunJson("failed", files);
+        } catch (const std::exception&) {
+        }
+    };
     std::vector<std::string> frameFiles;  // the current frame's, as they are completed
     try {
         for (int frame = 1; frame <= last; ++frame) {
@@ -254,20 +268,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         finish("blow-up");
         throw;
     } catch (...) {
-        // A write failed (a full disk): keep what is complete and mark the run failed, as far as
-        // the disk still allows; the original error is the one reported. When even run.json
-        // cannot be written it keeps saying "running".
         folder.wrote(frameFiles);
-        try {
-            stats.finish();
-            folder.wrote({"stats.csv"});
-        } catch (...) {
-        }
-        const std::vector<std::string> files = folder.finish();
-        try {
-            writeRunJson("failed", files);
-        } catch (...) {
-        }
+        finishAfterFailure();
         throw;
     }
     return s;

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "sim/FemCst.h"
 #include "sim/Fracture.h"

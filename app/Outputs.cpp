@@ -48,8 +48,8 @@ void StatsWriter::append(const Row& r) {
     write(row);
 }
 
-void StatsWriter::finish() {
-    if (!file_) return;
+bool StatsWriter::finish() {
+    if (!file_) return false;
     const fs::path partial = file_->path();
     std::error_code ec;
     try {
@@ -59,7 +59,7 @@ void StatsWriter::finish() {
         ec = e.code();
     }
     file_.reset();
-    if (!ec) return;
+    if (!ec) return true;
     fs::remove(partial, ec);
     throw std::system_error(ec, "cannot write " + path_.string());
 }

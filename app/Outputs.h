@@ -27,7 +27,8 @@ public:
         std::size_t brokenBonds;
     };
     void append(const Row& row);
-    void finish();
+    /// Renames stats.csv into place; false when a failed write already removed it.
+    bool finish();
 
 private:
     void write(const std::string& text);

@@ -228,16 +228,14 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.extraSubsteps = membrane.extraSubsteps();
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
-        stats.finish();
-        folder.wrote({"stats.csv"});
+        if (stats.finish()) folder.wrote({"stats.csv"});
         writeRunJson(status, folder.finish());
     };
     // A write failed (a full disk): keep what is complete and mark the run failed, as far as the
     // disk still allows. When even run.json cannot be written it keeps saying "running".
     auto finishAfterFailure = [&] {
         try {
-            stats.finish();
-            folder.wrote({"stats.csv"});
+            if (stats.finish()) folder.wrote({"stats.csv"});
         } catch (const std::exception&) {
         }
         const std::vector<std::string> files = folder.finish();

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <system_error>
 
 namespace fs = std::filesystem;
 using namespace rend;
@@ -69,4 +70,34 @@ TEST(RunFolder, AFolderWithoutRunJsonHasNoPreviousFiles) {
     RunFolder folder(dir, {"stats.csv"});
     EXPECT_TRUE(folder.removeStale().empty());
     EXPECT_TRUE(fs::exists(dir / "frames/frame_0001.png"));
+}
+
+TEST(StatsWriter, AFullDiskFailsNamingTheFileAndLeavesNoStats) {
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    const fs::path dir = folderWith("stats_full", {});
+    fs::create_directories(dir);
+    fs::create_symlink("/dev/full", dir / "stats.csv.partial");
+    try {
+        StatsWriter stats(dir / "stats.csv");
+        FAIL() << "writing the header to /dev/full succeeded";
+    } catch (const std::system_error& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "stats.csv.partial").string() +
+                                             ": No space left on device");
+    }
+    EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(StatsWriter, FinishRenamesTheRowsIntoPlace) {
+    const fs::path dir = folderWith("stats_ok", {});
+    fs::create_directories(dir);
+    StatsWriter stats(dir / "stats.csv");
+    stats.append({1, 0.5, 1.0, 2.0, 3.0, 0.0, 7});
+    EXPECT_TRUE(stats.finish());
+    EXPECT_FALSE(stats.finish());
+    std::ifstream in(dir / "stats.csv");
+    std::string header, row;
+    std::getline(in, header);
+    std::getline(in, row);
+    EXPECT_EQ(row, "1,0.5,1,2,3,0,7");
+    EXPECT_FALSE(fs::exists(dir / "stats.csv.partial"));
 }

@@ -26,6 +26,15 @@ std::string frameName(int frame, const char* extension) {
     return name;
 }
 
+// Folder and extension of each export format, in ExportFormat's order.
+constexpr std::pair<const char*, const char*> kExportFiles[] = {
+    {"meshes/", "ply"}, {"meshes/", "obj"}, {"meshes/", "glb"}, {"vdb/", "vdb"}};
+
+std::string exportName(int frame, ExportFormat format) {
+    const auto& [folder, extension] = kExportFiles[int(format)];
+    return folder + frameName(frame, extension);
+}
+
 const render::Mesh& asMesh(const render::Geometry& geometry, render::Mesh& scratch) {
     if (const auto* mesh = std::get_if<render::Mesh>(&geometry)) return *mesh;
     scratch = render::splatsToMesh(std::get<render::Splats>(geometry));
@@ -49,6 +58,16 @@ FrameWriter::~FrameWriter() = default;
 
 bool FrameWriter::active() const {
     return scene_.renderer != RendererKind::None || !scene_.exports.empty();
+}
+
+std::vector<std::string> FrameWriter::plannedFiles(int frame) const {
+    std::vector<std::string> names;
+    if (scene_.renderer != RendererKind::None) names.push_back("frames/" + frameName(frame, "png"));
+    for (ExportFormat format : scene_.exports) {
+        names.push_back(exportName(frame, format));
+        if (format == ExportFormat::Obj) names.push_back("meshes/" + frameName(frame, "mtl"));
+    }
+    return names;
 }
 
 render::Geometry FrameWriter::buildSurface(const sim::FrameView& view) {
@@ -82,31 +101,29 @@ void FrameWriter::exportFrame(const sim::FrameView& view, const render::Geometry
                               std::vector<std::string>& written) {
     render::Mesh scratch;
     for (ExportFormat format : scene_.exports) {
+        const std::string name = exportName(view.frame, format);
+        const std::filesystem::path path = outDir_ / name;
+        std::filesystem::create_directories(path.parent_path());
         if (format == ExportFormat::Vdb) {
             Parts& p = *parts_;
             if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
             // The vdb surface built its level set already; any other surface builds it here.
             if (scene_.render.surface != render::SurfaceKind::Vdb)
                 p.vdb->build(view, scene_.render);
-            std::filesystem::create_directories(outDir_ / "vdb");
-            const std::string name = "vdb/" + frameName(view.frame, "vdb");
-            p.vdb->writeVdb(outDir_ / name);
+            p.vdb->writeVdb(path);
             written.push_back(name);
             continue;
         }
-        static constexpr const char* kExtensions[] = {"ply", "obj", "glb"};
-        const char* extension = kExtensions[int(format)];
-        std::filesystem::create_directories(outDir_ / "meshes");
-        const std::string name = std::string("meshes/") + frameName(view.frame, extension);
-        render::exportMesh(asMesh(geometry, scratch), outDir_ / name,
-                           render::MeshFormat(int(format)));
-        written.push_back(name);
+        const std::string folder = kExportFiles[int(format)].first;
+        for (const std::filesystem::path& file :
+             render::exportMesh(asMesh(geometry, scratch), path, render::MeshFormat(int(format))))
+            written.push_back(folder + file.filename().string());
     }
 }
 
-std::vector<std::string> FrameWriter::write(const sim::FrameView& view, StageTimes& seconds) {
-    std::vector<std::string> written;
-    if (!active()) return written;
+void FrameWriter::write(const sim::FrameView& view, StageTimes& seconds,
+                        std::vector<std::string>& written) {
+    if (!active()) return;
     auto t0 = Clock::now();
     const render::Geometry geometry = buildSurface(view);
     seconds.surface += secondsSince(t0);
@@ -124,7 +141,6 @@ std::vector<std::string> FrameWriter::write(const sim::FrameView& view, StageTim
     t0 = Clock::now();
     exportFrame(view, geometry, written);
     seconds.write += secondsSince(t0);
-    return written;
 }
 
 }  // namespace rend

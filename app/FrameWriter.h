@@ -26,8 +26,12 @@ public:
     /// Whether frames produce any file (a PNG or an export).
     bool active() const;
 
-    /// Writes the frame's files; returns their paths relative to the output folder.
-    std::vector<std::string> write(const sim::FrameView& view, StageTimes& seconds);
+    /// The files write() makes for `frame`, relative to the output folder (an OBJ's .mtl too).
+    std::vector<std::string> plannedFiles(int frame) const;
+
+    /// Writes the frame's files, appending each one's path relative to the output folder to
+    /// `written` as soon as it is complete (so a failed write leaves the list right).
+    void write(const sim::FrameView& view, StageTimes& seconds, std::vector<std::string>& written);
 
 private:
     render::Geometry buildSurface(const sim::FrameView& view);

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include "app/FrameWriter.h"
 #include "app/Outputs.h"
 #include "app/SceneError.h"
+#include "render/AtomicFile.h"
 
 namespace rend {
 namespace {
@@ -162,7 +164,7 @@ std::string stateHash(const sim::Membrane& m) {
 }
 
 std::string runJson(const Scene& scene, const RunSummary& s, const std::string& status,
-                    const std::string& hash) {
+                    const std::string& hash, const std::vector<std::string>& files) {
     std::ostringstream j;
     j.precision(10);
     j << "{\n  \"rend_version\": " << jsonString(REND_VERSION) << ",\n"
@@ -180,9 +182,62 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write << "},\n"
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
       << "  \"state_hash\": " << jsonString(hash) << ",\n"
+      << "  \"files\": " << jsonStringArray(files, "  ") << ",\n"
       << "  \"resolved_scene\": " << (scene.resolvedJson.empty() ? "{}" : scene.resolvedJson)
       << "\n}\n";
     return j.str();
+}
+
+// The files a run writes: each written frame's and stats.csv when asked for (run.json is the
+// list itself).
+std::vector<std::string> plannedFiles(const FrameWriter& writer, int first, int last,
+                                      bool withStats) {
+    std::vector<std::string> names;
+    if (withStats) names.push_back("stats.csv");
+    for (int frame = first; frame <= last; ++frame)
+        for (std::string& name : writer.plannedFiles(frame)) names.push_back(std::move(name));
+    return names;
+}
+
+void reportRemoved(const std::vector<std::string>& removed, const std::filesystem::path& dir) {
+    if (removed.empty()) return;
+    std::string names;
+    for (std::size_t k = 0; k < std::min<std::size_t>(removed.size(), 3); ++k)
+        names += (k ? ", " : "") + removed[k];
+    std::fprintf(stderr,
+                 "removed %zu file%s of the previous run in %s that this run does not "
+                 "write (%s%s)\n",
+                 removed.size(), removed.size() == 1 ? "" : "s", dir.c_str(), names.c_str(),
+                 removed.size() > 3 ? ", ..." : "");
+}
+
+// The frame's stats row. A value that is not finite stops the run before the row or the frame
+// is written, naming the fastest particle (the guard's checks normally stop it earlier).
+StatsWriter::Row frameStats(int frame, const sim::Membrane& m) {
+    const StatsWriter::Row row{frame,        m.time(),     m.kineticEnergy(),  m.strainEnergy(),
+                               m.maxSpeed(), m.maxTheta(), m.brokenBondCount()};
+    const std::pair<const char*, double> values[] = {{"kinetic energy", row.kineticEnergy},
+                                                     {"strain energy", row.strainEnergy},
+                                                     {"largest speed", row.maxSpeed},
+                                                     {"largest theta", row.maxTheta}};
+    for (const auto& [name, value] : values) {
+        if (std::isfinite(value)) continue;
+        const auto& v = m.velocities();
+        const int fastest = int(std::max_element(v.begin(), v.end(),
+                                                 [](const auto& a, const auto& b) {
+                                                     return a.squaredNorm() < b.squaredNorm();
+                                                 }) -
+                                v.begin());
+        const double suggested = sim::suggestedTimeStep(m.timeStep(), m.stableTimeStep());
+        std::ostringstream msg;
+        msg << "numerical blow-up at step " << m.stepCount() << " (t = " << m.time() << " s): the "
+            << name << " of frame " << frame << " is not finite; the fastest particle is particle "
+            << fastest << ". Use a smaller dt";
+        if (suggested > 0.0) msg << " (dt <= " << suggested << ")";
+        msg << " or milder boundary velocities, gravity, pressure or material values.";
+        throw sim::NumericalBlowUp(msg.str(), m.stepCount(), fastest, suggested);
+    }
+    return row;
 }
 
 }  // namespace
@@ -273,9 +328,17 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     const auto [first, last] = options.frames.value_or(std::pair{1, frames});
 
     std::filesystem::create_directories(options.outDir);
+    FrameWriter writer(scene, options.outDir);
+    RunFolder folder(options.outDir, plannedFiles(writer, first, last, scene.writeStats));
+    auto writeRunJson = [&](const std::string& status, const std::vector<std::string>& files) {
+        render::writeFileAtomic(options.outDir / "run.json",
+                                runJson(scene, s, status, stateHash(membrane), files));
+    };
+    // Before anything else is written, so a killed run never leaves a folder that looks done.
+    writeRunJson("running", folder.listedWhileRunning());
+    reportRemoved(folder.removeStale(), options.outDir);
     std::optional<StatsWriter> stats;
     if (scene.writeStats) stats.emplace(options.outDir / "stats.csv");
-    FrameWriter writer(scene, options.outDir);
     Progress progress(options.progressBar, last);
     s.seconds.setup = secondsSince(t0);
 
@@ -284,33 +347,49 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.extraSubsteps = membrane.extraSubsteps();
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
-        if (stats) stats->finish();
-        writeFileAtomic(options.outDir / "run.json",
-                        runJson(scene, s, status, stateHash(membrane)));
+        if (stats && stats->finish()) folder.wrote({"stats.csv"});
+        writeRunJson(status, folder.finish());
     };
+    // A write failed (a full disk): keep what is complete and mark the run failed, as far as the
+    // disk still allows. When even run.json cannot be written it keeps saying "running".
+    auto finishAfterFailure = [&] {
+        try {
+            if (stats && stats->finish()) folder.wrote({"stats.csv"});
+        } catch (const std::exception&) {
+        }
+        const std::vector<std::string> files = folder.finish();
+        try {
+            writeRunJson("failed", files);
+        } catch (const std::exception&) {
+        }
+    };
+    std::vector<std::string> frameFiles;  // the current frame's, as they are completed
     try {
         for (int frame = 1; frame <= last; ++frame) {
             t0 = Clock::now();
             for (int k = 0; k < substeps; ++k) membrane.step();
             s.seconds.simulate += secondsSince(t0);
             s.framesSimulated = frame;
-            if (stats)
-                stats->append({frame, membrane.time(), membrane.kineticEnergy(),
-                               membrane.strainEnergy(), membrane.maxSpeed(), membrane.maxTheta(),
-                               membrane.brokenBondCount()});
-            std::vector<std::string> wrote;
+            const StatsWriter::Row row = frameStats(frame, membrane);  // checks it is finite
+            if (stats) stats->append(row);
+            frameFiles.clear();
             if (frame >= first && writer.active()) {
                 membrane.updateDamage();
-                wrote = writer.write(membrane.view(frame), s.seconds);
+                writer.write(membrane.view(frame), s.seconds, frameFiles);
+                folder.wrote(frameFiles);
                 ++s.framesWritten;
             }
-            progress.frameDone(frame, membrane.time(), wrote.empty() ? "" : wrote.front());
+            progress.frameDone(frame, membrane.time(), frameFiles.empty() ? "" : frameFiles[0]);
         }
+        finish("ok");
     } catch (const sim::NumericalBlowUp&) {
         finish("blow-up");
         throw;
+    } catch (...) {
+        folder.wrote(frameFiles);
+        finishAfterFailure();
+        throw;
     }
-    finish("ok");
     return s;
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <system_error>
 
+#include "render/AtomicFile.h"
+
 // stb is third-party C; its warnings under -Wextra -Wpedantic are not ours to fix.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wall"
@@ -55,21 +57,16 @@ void markPixel(Image& diff, std::size_t pixel, bool failing) {
 
 void writePngAtomic(const Image& image, const std::filesystem::path& path) {
     checkShape(image);
-    std::filesystem::path tmp = path;
-    tmp += ".tmp";
-    const int ok = stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.rgb.data(),
-                                  image.width * 3);
-    if (!ok) {
-        std::error_code ignored;
-        std::filesystem::remove(tmp, ignored);
-        throw std::runtime_error("cannot write PNG " + tmp.string());
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw std::runtime_error("cannot move PNG into place at " + path.string());
-    }
+    // Encoded in memory, then written with every write checked: stb's own file writer ignores
+    // fwrite's and fclose's errors, which leaves truncated PNGs behind on a full disk.
+    std::string png;
+    const auto append = [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), size);
+    };
+    if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(),
+                                image.width * 3))
+        throw std::runtime_error("cannot encode PNG " + path.string());
+    writeFileAtomic(path, png);
 }
 
 Image readPng(const std::filesystem::path& path) {

@@ -12,8 +12,9 @@ struct Image {
     std::vector<std::uint8_t> rgb;  ///< width * height * 3
 };
 
-/// Writes a PNG through stb_image_write to `path` + ".tmp" and renames it into place, so a
-/// reader never sees a half-written frame. Throws std::runtime_error on failure.
+/// Encodes a PNG with stb_image_write and writes it with writeFileAtomic (render/AtomicFile.h):
+/// a reader never sees a half-written frame, and a failed write throws naming the path and the
+/// reason, leaving nothing under `path`.
 void writePngAtomic(const Image& image, const std::filesystem::path& path);
 
 /// Reads an 8-bit PNG (any channel count, converted to RGB). Throws on failure.

@@ -5,16 +5,19 @@
 
 #include <algorithm>
 #include <assimp/Exporter.hpp>
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
 #include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "render/AtomicFile.h"
 
 namespace rend::render {
 
@@ -88,11 +91,7 @@ void writePly(const Mesh& mesh, const fs::path& path) {
     const bool colors = mesh.colors.size() == mesh.positions.size();
     const std::string header = plyHeader(mesh, normals, colors);
     const std::vector<char> body = plyBody(mesh, normals, colors);
-    std::ofstream out(path, std::ios::binary);
-    out.write(header.data(), std::streamsize(header.size()));
-    out.write(body.data(), std::streamsize(body.size()));
-    out.close();
-    if (!out) throw std::runtime_error("write failed");
+    writeFileAtomic(path, header + std::string(body.begin(), body.end()));
 }
 
 aiMaterial* defaultMaterial() {
@@ -160,22 +159,85 @@ std::unique_ptr<aiScene> makeScene(const Mesh& mesh) {
     return scene;
 }
 
-void writeWithAssimp(const Mesh& mesh, const fs::path& path, MeshFormat format) {
+// assimp's own file streams ignore fwrite's and fclose's results, so a full disk leaves a
+// truncated file. The exporter writes into memory instead, one buffer per file it opens (the OBJ
+// opens its .mtl too), and writeFileAtomic puts them on disk with every write checked.
+class MemoryStream : public Assimp::IOStream {
+public:
+    explicit MemoryStream(std::string& bytes) : bytes_(bytes) {}
+    size_t Read(void*, size_t, size_t) override { return 0; }
+    size_t Write(const void* data, size_t size, size_t count) override {
+        const std::size_t n = size * count;
+        if (position_ + n > bytes_.size()) bytes_.resize(position_ + n);
+        std::memcpy(bytes_.data() + position_, data, n);
+        position_ += n;
+        return count;
+    }
+    aiReturn Seek(size_t offset, aiOrigin origin) override {
+        const std::size_t base = origin == aiOrigin_SET   ? 0
+                                 : origin == aiOrigin_CUR ? position_
+                                                          : bytes_.size();
+        position_ = base + offset;  // past the end, as in a file: the gap reads as zeros
+        if (position_ > bytes_.size()) bytes_.resize(position_);
+        return aiReturn_SUCCESS;
+    }
+    size_t Tell() const override { return position_; }
+    size_t FileSize() const override { return bytes_.size(); }
+    void Flush() override {}
+
+private:
+    std::string& bytes_;
+    std::size_t position_ = 0;
+};
+
+/// Files by the name the exporter opened them with, in the order it opened them.
+using MemoryFiles = std::vector<std::pair<std::string, std::string>>;
+
+class MemoryIoSystem : public Assimp::IOSystem {
+public:
+    explicit MemoryIoSystem(MemoryFiles& files) : files_(files) { files_.reserve(8); }
+    bool Exists(const char* name) const override {
+        return std::any_of(files_.begin(), files_.end(),
+                           [&](const auto& file) { return file.first == name; });
+    }
+    char getOsSeparator() const override { return '/'; }
+    Assimp::IOStream* Open(const char* name, const char* mode) override {
+        if (std::string_view(mode).find('r') != std::string_view::npos) return nullptr;
+        // reserve() above keeps the references valid for the handful of files an export opens.
+        if (files_.size() == files_.capacity()) return nullptr;
+        files_.emplace_back(name, std::string());
+        return new MemoryStream(files_.back().second);
+    }
+    void Close(Assimp::IOStream* stream) override { delete stream; }
+
+private:
+    MemoryFiles& files_;
+};
+
+// Writes every file the exporter produced next to `target`, the main file last: a reader who
+// finds the OBJ then also finds its complete .mtl.
+std::vector<fs::path> writeWithAssimp(const Mesh& mesh, const fs::path& path, MeshFormat format) {
     const std::unique_ptr<aiScene> scene = makeScene(mesh);
+    MemoryFiles files;
     Assimp::Exporter exporter;
+    exporter.SetIOHandler(new MemoryIoSystem(files));  // the exporter owns and deletes it
     if (exporter.Export(scene.get(), assimpFormatId(format), path.string()) != AI_SUCCESS)
         throw std::runtime_error(exporter.GetErrorString());
-}
-
-// Moves every file the writer put into `staging` next to `target`, the main file last: a reader
-// who finds the OBJ then also finds its complete .mtl.
-void publish(const fs::path& staging, const fs::path& target) {
-    const fs::path main = staging / target.filename();
+    std::stable_partition(files.begin(), files.end(),
+                          [&](const auto& file) { return fs::path(file.first) != path; });
     std::vector<fs::path> written;
-    for (const auto& entry : fs::directory_iterator(staging))
-        if (entry.path() != main) written.push_back(entry.path());
-    for (const auto& file : written) fs::rename(file, target.parent_path() / file.filename());
-    fs::rename(main, target);
+    try {
+        for (const auto& [name, bytes] : files) {
+            const fs::path file = path.parent_path() / fs::path(name).filename();
+            writeFileAtomic(file, bytes);
+            written.push_back(file);
+        }
+    } catch (...) {
+        std::error_code ignored;  // an .mtl without its .obj is no output
+        for (const fs::path& file : written) fs::remove(file, ignored);
+        throw;
+    }
+    return written;
 }
 
 }  // namespace
@@ -203,22 +265,16 @@ std::string_view meshFormatExtension(MeshFormat format) {
     return "";
 }
 
-void exportMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format) {
-    fs::path staging = path;
-    staging += ".tmp";
-    std::error_code ignored;
-    fs::remove_all(staging, ignored);  // left over from a crashed run
+std::vector<fs::path> exportMesh(const Mesh& mesh, const fs::path& path, MeshFormat format) {
+    if (format == MeshFormat::Ply) {
+        writePly(mesh, path);
+        return {path};
+    }
     try {
-        fs::create_directories(staging);
-        const fs::path staged = staging / path.filename();
-        if (format == MeshFormat::Ply)
-            writePly(mesh, staged);
-        else
-            writeWithAssimp(mesh, staged, format);
-        publish(staging, path);
-        fs::remove_all(staging);
+        return writeWithAssimp(mesh, path, format);
+    } catch (const std::system_error&) {
+        throw;  // already names the file and the reason
     } catch (const std::exception& e) {
-        fs::remove_all(staging, ignored);
         throw std::runtime_error("cannot export " + path.string() + ": " + e.what());
     }
 }

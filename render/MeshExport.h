@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string_view>
+#include <vector>
 
 #include "render/Mesh.h"
 
@@ -22,11 +23,13 @@ std::string_view meshFormatExtension(MeshFormat format);
 
 /// Writes positions, triangles, per-vertex normals and colours: GLB as linear COLOR_0 (glTF's
 /// convention), PLY as 8-bit red/green/blue encoded with gamma 1/2.2 (viewers show PLY bytes
-/// as sRGB), OBJ only as the non-standard "v x y z r g b" extension. Every file (OBJ's .mtl too) is
-/// first written into the folder `path` + ".tmp" and then renamed next to `path`, the main file
-/// last, so a reader never sees a half-written file nor an OBJ whose material library is missing.
-/// Throws std::runtime_error (with assimp's error string where assimp failed), leaving nothing
-/// behind.
-void exportMesh(const Mesh& mesh, const std::filesystem::path& path, MeshFormat format);
+/// as sRGB), OBJ only as the non-standard "v x y z r g b" extension. The files (OBJ's .mtl too)
+/// are encoded in memory and written with writeFileAtomic (render/AtomicFile.h) next to `path`,
+/// the main file last, so a reader never sees a half-written file nor an OBJ whose material
+/// library is missing. Returns the files written, `path` last. Throws std::system_error naming
+/// the file and the reason when a write fails, std::runtime_error with assimp's error string
+/// where assimp failed; a file that failed is not left behind.
+std::vector<std::filesystem::path> exportMesh(const Mesh& mesh, const std::filesystem::path& path,
+                                              MeshFormat format);
 
 }  // namespace rend::render

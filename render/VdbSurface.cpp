@@ -12,18 +12,30 @@
 #include <limits>
 #include <mutex>
 #include <span>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
 
+#include "render/AtomicFile.h"
 #include "render/ColorMap.h"
 #include "render/SplatSurface.h"
 
 namespace rend::render {
 
 namespace {
+
+// io::File writes through an std::ofstream whose state it never checks, so a full disk leaves a
+// truncated .vdb. The same archive (seekable, as io::File writes it) goes into memory instead,
+// and writeFileAtomic puts it on disk with every write checked.
+class MemoryArchive : public openvdb::io::Archive {
+public:
+    void writeTo(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
+        Archive::write(out, grids, /*seekable=*/true);
+    }
+};
 
 constexpr double kDefaultVoxelFactor = 0.5;    // voxel = dx / 2
 constexpr double kDefaultRadiusFactor = 0.75;  // radius = 0.75 dx: a ~1.5 dx thick pillow
@@ -318,18 +330,13 @@ std::uint64_t VdbSurface::activeVoxelCount() const {
 
 void VdbSurface::writeVdb(const std::filesystem::path& path) const {
     if (!grid_) throw std::logic_error("VdbSurface::writeVdb called before build");
-    std::filesystem::path tmp = path;
-    tmp += ".tmp";
+    std::ostringstream bytes(std::ios::binary);
     try {
-        openvdb::io::File file(tmp.string());
-        file.write(openvdb::GridCPtrVec{grid_->levelSet});
-        file.close();
-        std::filesystem::rename(tmp, path);
+        MemoryArchive().writeTo(bytes, openvdb::GridCPtrVec{grid_->levelSet});
     } catch (const std::exception& e) {
-        std::error_code ignored;
-        std::filesystem::remove(tmp, ignored);
         throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
     }
+    writeFileAtomic(path, bytes.view());
 }
 
 VdbFileInfo inspectVdb(const std::filesystem::path& path) {

@@ -34,9 +34,10 @@ public:
     /// nearest particle (particleColors). Keeps the grid for writeVdb.
     Mesh build(const sim::FrameView& frame, const RenderSettings& settings);
 
-    /// Writes the last built level set (one float grid named "surface") to `path`, through
-    /// `path` + ".tmp" renamed into place so a reader never sees half a file. Throws
-    /// std::logic_error before the first build, std::runtime_error on I/O failure.
+    /// Writes the last built level set (one float grid named "surface") to `path` with
+    /// writeFileAtomic (render/AtomicFile.h): never half a file under `path`. Throws
+    /// std::logic_error before the first build, std::runtime_error (naming the path and the
+    /// reason) on failure.
     void writeVdb(const std::filesystem::path& path) const;
 
     /// Particles OpenVDB skipped in the last build (too small or too large for the grid).

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/BlowUpGuard.h"
 #include "sim/BondLaw.h"
 #include "sim/Bonds.h"
 #include "sim/Diffusion.h"
@@ -25,17 +26,6 @@
 #include "sim/Solver.h"
 
 namespace rend::sim {
-
-/// The state stopped being finite, or a particle ran away faster than anything the material
-/// or the boundary conditions can produce.
-class NumericalBlowUp : public std::runtime_error {
-public:
-    NumericalBlowUp(const std::string& message, long step, int particle, double suggestedDt)
-        : std::runtime_error(message), step(step), particle(particle), suggestedDt(suggestedDt) {}
-    long step;
-    int particle;
-    double suggestedDt;
-};
 
 /// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
 /// lattice row store the fracture energy G_f (infinity without one).
@@ -138,7 +128,7 @@ private:
     static constexpr std::int16_t kFree = -1;
     static constexpr std::int16_t kPinned = -2;
 
-    /// Stable step and runaway-speed limit from max_i k_i / m_i (Solver::stiffnessRowSums).
+    /// Stable step and the blow-up guard from max_i k_i / m_i (Solver::stiffnessRowSums).
     void setStableStep(double worstRatio);
     /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
     void breakBond(int i, int j);
@@ -151,7 +141,7 @@ private:
     void stepVelocityVerlet();
     /// v += h * acceleration for free particles; prescribed velocities for the others.
     void kick(double h, double tNext);
-    void checkFinite();
+    void checkFinite();  ///< the blow-up guard, after every step
     /// Notches: breaks the bonds they cross and has the solver cut the same edges.
     void setUpNotches(const MembraneParams& params);
     void assignBoundaries();
@@ -161,8 +151,6 @@ private:
     void integrate(double h, double tNext);
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
-    [[noreturn]] void reportBlowUp() const;
-    bool isBad(int i) const;
 
     MembraneParams params_;
     Lattice lattice_;
@@ -175,7 +163,7 @@ private:
     double dt_ = 0.0;
     double time_ = 0.0;
     long steps_ = 0;
-    double speedLimit_ = 0.0;
+    BlowUpGuard guard_;
     std::unique_ptr<Solver> solver_;  ///< the internal forces
     double stiffening_ = 1.0;         ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;               ///< extra pieces the power law's stiffening asked for

@@ -169,5 +169,93 @@ check "--threads 0 refused" run 2 run scenes/stretch.toml --threads 0 --out "$tm
 check "--frames given twice refused" run 2 run scenes/stretch.toml --frames 1 --frames 2 --out "$tmp/twice"
 check "refused options leave no output" bash -c "! ls -d '$tmp/threads0' '$tmp/twice' '$tmp/bad_out' 2>/dev/null | grep -q ."
 
+# Hostile output conditions (helper "outputs"): a full disk, reruns into the same folder, a killed
+# run, and the blow-up guard stopping early enough.
+pngs_complete() {  # every PNG under $1 ends with its IEND chunk and decodes fully
+    python3 - "$1" <<'PY'
+import pathlib, struct, sys, zlib
+for png in pathlib.Path(sys.argv[1]).rglob("*.png"):
+    data = png.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[-8:-4] == b"IEND", png
+    at, idat = 8, b""
+    while at < len(data):
+        (n,) = struct.unpack(">I", data[at:at + 4])
+        if data[at + 4:at + 8] == b"IDAT":
+            idat += data[at + 8:at + 8 + n]
+        at += 12 + n
+    zlib.decompress(idat)
+PY
+}
+no_empty_files() { ! find "$1" -type f -empty | grep -q .; }
+json_status() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['status'])" "$1"; }
+full_disk() {  # full_disk KIB args... : rend run, writes past KIB KiB fail (EFBIG); exits 1?
+    local limit=$1
+    shift
+    (
+        trap '' XFSZ
+        ulimit -f "$limit"
+        "$rend" run "$@" >"$tmp/stdout" 2>"$tmp/stderr"
+    )
+    [[ $? -eq 1 ]]
+}
+check "full disk at a PNG exits 1" full_disk 40 scenes/stretch.toml "${small[@]}" --out "$tmp/full" \
+    --set render.width=1920 --set render.height=1080
+check "full disk names the PNG and the reason" grep -q "cannot write $tmp/full/frames/frame_0001.png: File too large" "$tmp/stderr"
+check "full disk leaves no truncated PNG" pngs_complete "$tmp/full"
+check "full disk leaves no empty file" no_empty_files "$tmp/full"
+check "full disk leaves no partial files" no_partial_files "$tmp/full"
+check "full disk keeps stats.csv complete up to the failure" test "$(wc -l <"$tmp/full/stats.csv")" -ge 2
+check "full disk run.json says failed" test "$(json_status "$tmp/full/run.json")" = failed
+check "full disk at an OBJ exits 1" full_disk 40 scenes/stretch.toml "${small[@]}" --out "$tmp/fullobj" --export ply,obj
+check "full disk names the OBJ" grep -q "cannot write $tmp/fullobj/meshes/frame_0001.obj: File too large" "$tmp/stderr"
+check "full disk leaves no OBJ nor its MTL" test ! -e "$tmp/fullobj/meshes/frame_0001.obj" -a ! -e "$tmp/fullobj/meshes/frame_0001.mtl"
+check "full disk lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['frames/frame_0001.png','meshes/frame_0001.ply','stats.csv'], f" "$tmp/fullobj/run.json"
+check "full disk keeps the frames before the failure whole" pngs_complete "$tmp/fullobj"
+check "full disk at run.json exits 1" full_disk 1 scenes/stretch.toml "${small[@]}" --out "$tmp/fulljson"
+check "full disk at run.json writes nothing" test -z "$(find "$tmp/fulljson" -type f)"
+check "full disk at a VDB exits 1" full_disk 100 scenes/stretch.toml "${small[@]}" --out "$tmp/fullvdb" \
+    --renderer none --export vdb
+check "full disk at a VDB names it" grep -q "cannot write $tmp/fullvdb/vdb/frame_0001.vdb: File too large" "$tmp/stderr"
+check "full disk leaves no VDB" test -z "$(find "$tmp/fullvdb" -name '*.vdb*')"
+
+# A rerun replaces the previous run's files: 12 frames, then 6, leaves 6 and says so.
+rerun=(scenes/stretch.toml --set 'sheet.size=[0.4,0.4]' --set time.duration=0.5 --set render.width=32 --set render.height=32 --out "$tmp/rerun")
+check "first run of 12 frames" run 0 run "${rerun[@]}" --export ply
+check "rerun of 6 frames" run 0 run "${rerun[@]}" --frames 1-6
+check "rerun says what it removed" grep -q "removed 18 files of the previous run in $tmp/rerun that this run does not write" "$tmp/stderr"
+check "rerun leaves exactly 6 PNGs" test "$(ls "$tmp/rerun/frames" | tr '\n' ' ')" = "frame_0001.png frame_0002.png frame_0003.png frame_0004.png frame_0005.png frame_0006.png "
+check "rerun removes the stale meshes and their folder" test ! -e "$tmp/rerun/meshes"
+check "rerun run.json says 6" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['frames_written']==6 and d['status']=='ok' and len(d['files'])==7, d['files']" "$tmp/rerun/run.json"
+touch "$tmp/rerun/frames/notes.txt" "$tmp/rerun/frames/frame_0009.png"
+check "rerun of frames 3-4" run 0 run "${rerun[@]}" --frames 3-4
+check "a --frames rerun keeps only its own frames and files rend never wrote" test "$(ls "$tmp/rerun/frames" | tr '\n' ' ')" = "frame_0003.png frame_0004.png frame_0009.png notes.txt "
+printf '{"files": ["../../outside.txt", "/etc/hostname", "frames/../stats.csv"]}\n' >"$tmp/rerun/run.json"
+touch "$tmp/outside.txt"
+check "a hostile run.json" run 0 run "${rerun[@]}" --frames 3-4
+check "a hostile run.json removes nothing outside rend's names" test -e "$tmp/outside.txt" -a -e /etc/hostname
+
+# kill -9 mid-run: run.json says the run did not finish.
+"$rend" run scenes/stretch.toml --set time.duration=2 --renderer none --out "$tmp/rerun" >/dev/null 2>&1 &
+killed=$!
+for _ in $(seq 50); do [[ -e "$tmp/rerun/stats.csv.partial" ]] && break; sleep 0.1; done
+sleep 0.5
+kill -9 $killed
+wait $killed 2>/dev/null
+check "a killed run leaves run.json saying running" test "$(json_status "$tmp/rerun/run.json")" = running
+check "a rerun after a kill" run 0 run "${rerun[@]}" --frames 1-6
+check "a rerun after a kill is complete and clean" test "$(json_status "$tmp/rerun/run.json")" = ok
+check "a rerun after a kill leaves no partial files" no_partial_files "$tmp/rerun"
+
+# The guard stops the issue's unstable stretch (dt = 1/120 s, 1.44 x the bound) at frame 5, while
+# the largest speed is 0.27 m/s, where it used to run to frame 8 and 176 m/s.
+check "unstable stretch is caught" run 3 run scenes/stretch.toml --set time.dt=0.0084 \
+    --set time.allow_unstable=true --renderer none --out "$tmp/guard"
+check "unstable stretch is caught in frame 5" test "$(wc -l <"$tmp/guard/stats.csv")" -eq 5
+check "guard message names the growth" grep -q "kinetic energy grew" "$tmp/stderr"
+check "guard message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
+check "absurd gravity is caught without inf advice" run 3 run scenes/stretch.toml "${small[@]}" \
+    --set 'forces.gravity=[0,0,-1e300]' --renderer none --out "$tmp/gravity"
+check "absurd gravity message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -1,0 +1,163 @@
+#include "sim/BlowUpGuard.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "sim/Parallel.h"
+
+namespace rend::sim {
+namespace {
+
+constexpr std::int16_t kFree = -1;
+constexpr int kBlock = 1024;  // particles per partial sum; fixed, so sums do not depend on threads
+
+// A NaN or an overflow never becomes a limit: anything not below the cap is the cap.
+double capped(double value, double cap) { return value < cap ? value : cap; }
+
+}  // namespace
+
+double suggestedTimeStep(double dt, double stableDt) {
+    const double suggested = 0.5 * std::min(dt, stableDt);
+    return std::isfinite(suggested) && suggested > 0.0 ? suggested : 0.0;
+}
+
+BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
+                         std::span<const double> mass, std::span<const double> volume) {
+    // A runaway particle moves far faster than the fastest wave (~dx * omega_max), anything the
+    // boundaries impose, or free fall over the whole run.
+    double boundarySpeed = 0.0;
+    for (const auto& bc : params.boundaries)
+        boundarySpeed = std::max(boundarySpeed, capped(bc.velocity.norm(), kLightSpeed));
+    const double waveSpeed = capped(params.sheet.dx * std::sqrt(worstRatio), kLightSpeed);
+    const double fall =
+        capped(params.gravity.norm(), kLightSpeed) * capped(params.time.duration, kLightSpeed);
+    speedLimit_ = capped(100.0 * waveSpeed + 10.0 * boundarySpeed + 2.0 * fall + 1e-6, kLightSpeed);
+
+    gravity_ = params.gravity.allFinite() ? params.gravity : Eigen::Vector3d::Zero();
+    hasGravity_ = gravity_ != Eigen::Vector3d::Zero();
+    const double totalVolume = std::accumulate(volume.begin(), volume.end(), 0.0);
+    const double totalMass = std::accumulate(mass.begin(), mass.end(), 0.0);
+    // A follower pressure does at most p A v of work per second; 4 A allows the sheet to
+    // double in size.
+    pressureArea_ = std::abs(params.pressure) * 4.0 * totalVolume / params.sheet.thickness;
+    // A free expansion strain alpha theta held back costs at most E (alpha theta)^2 / 2 per
+    // unit volume in each of two directions.
+    const MaterialParams& m = params.material;
+    thermalEnergy_ = m.youngsModulus * m.expansion * m.expansion * totalVolume;
+    // Below the energy of the whole sheet moving at a thousandth of the wave speed, growth is
+    // noise in a state at rest, not a blow-up.
+    floor_ = 0.5 * totalMass * std::pow(1e-3 * waveSpeed, 2);
+}
+
+// One block's sums. Only v is checked for finiteness: x moves by dt v from a finite start, so a
+// non-finite x has had a non-finite v first (or one over the limit), and skipping it halves the
+// memory the pass reads.
+void BlowUpGuard::sampleBlock(const State& s, int begin, int end, Sample& out) const {
+    const double limitSquared = speedLimit_ * speedLimit_;
+    for (int i = begin; i < end; ++i) {
+        const double speedSquared = s.v[i].squaredNorm();
+        if (!(speedSquared <= limitSquared) && out.firstBad < 0) out.firstBad = i;
+        if (s.constraint[i] != kFree) {
+            if (s.constraint[i] >= 0) out.boundaryPower += std::abs(s.force[i].dot(s.v[i]));
+            continue;
+        }
+        out.kinetic += 0.5 * s.mass[i] * speedSquared;
+        if (hasGravity_) out.gravityPower += s.mass[i] * std::abs(gravity_.dot(s.v[i]));
+        if (speedSquared > out.maxSpeedSquared) {
+            out.maxSpeedSquared = speedSquared;
+            out.fastest = i;
+        }
+    }
+    if (s.theta.empty()) return;
+    for (int i = begin; i < end; ++i) {
+        if (!std::isfinite(s.theta[i]) && (out.firstBad < 0 || i < out.firstBad)) out.firstBad = i;
+        out.maxAbsTheta = std::max(out.maxAbsTheta, std::abs(s.theta[i]));
+    }
+}
+
+BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
+    const int n = int(s.v.size());
+    const int blocks = (n + kBlock - 1) / kBlock;
+    blocks_.assign(blocks, Sample{});
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int b = 0; b < blocks; ++b)
+        sampleBlock(s, b * kBlock, std::min(n, (b + 1) * kBlock), blocks_[b]);
+    Sample total;
+    for (const Sample& b : blocks_) {
+        total.kinetic += b.kinetic;
+        total.boundaryPower += b.boundaryPower;
+        total.gravityPower += b.gravityPower;
+        total.maxAbsTheta = std::max(total.maxAbsTheta, b.maxAbsTheta);
+        if (b.maxSpeedSquared > total.maxSpeedSquared) {
+            total.maxSpeedSquared = b.maxSpeedSquared;
+            total.fastest = b.fastest;
+        }
+        if (total.firstBad < 0) total.firstBad = b.firstBad;
+    }
+    return total;
+}
+
+void BlowUpGuard::addWork(const State& state, const Sample& s) {
+    const double power =
+        s.boundaryPower + s.gravityPower + pressureArea_ * std::sqrt(s.maxSpeedSquared);
+    budget_ += state.dt * power;
+}
+
+void BlowUpGuard::check(const State& state, const std::function<double()>& totalEnergy) {
+    const Sample s = sample(state);
+    if (s.firstBad >= 0) report(state, s, "");
+    if (!started_) {
+        started_ = true;
+        budget_ = floor_ + std::max(0.0, totalEnergy());
+        lastKinetic_ = s.kinetic;
+        return;
+    }
+    addWork(state, s);
+    const bool growing = s.kinetic >= kGrowth * lastKinetic_ && s.kinetic > 0.0;
+    growingSteps_ = growing ? growingSteps_ + 1 : 0;
+    growthProduct_ = growing ? growthProduct_ * s.kinetic / lastKinetic_ : 1.0;
+    lastKinetic_ = s.kinetic;
+    const double allowed = budget_ + thermalEnergy_ * s.maxAbsTheta * s.maxAbsTheta;
+    if (growingSteps_ < kGrowthSteps || !(s.kinetic > kBudgetFactor * allowed)) return;
+    std::ostringstream why;
+    why.precision(3);
+    why << "the kinetic energy grew " << std::pow(growthProduct_, 1.0 / growingSteps_)
+        << "x per step over the last " << growingSteps_ << " steps to " << s.kinetic << " J, "
+        << s.kinetic / allowed
+        << " times the most the start state, the boundaries, gravity, pressure and expansion "
+           "can have put in ("
+        << allowed << " J)";
+    report(state, s, why.str());
+}
+
+void BlowUpGuard::report(const State& state, const Sample& s, const std::string& why) const {
+    const int culprit = s.firstBad >= 0 ? s.firstBad : std::max(0, s.fastest);
+    const double suggested = suggestedTimeStep(state.dt, state.stableDt);
+    const Eigen::Vector3d& rest = state.restPositions[culprit];
+    std::ostringstream out;
+    out << "numerical blow-up at step " << state.step << " (t = " << state.time << " s): ";
+    if (!why.empty()) out << why << "; the fastest particle is ";
+    out << "particle " << culprit << " (rest position " << rest.x() << ", " << rest.y() << ")";
+    const double speed = state.v[culprit].stableNorm();  // no overflow to inf
+    if (!state.x[culprit].allFinite() || !state.v[culprit].allFinite())
+        out << " has a position or velocity that is not finite.";
+    else if (!state.theta.empty() && !std::isfinite(state.theta[culprit]))
+        out << " has a diffusive quantity that is not finite.";
+    else if (why.empty())
+        out << " has speed " << speed << " m/s, beyond the plausible limit " << speedLimit_
+            << " m/s.";
+    else
+        out << " at " << speed << " m/s.";
+    out << " The time step " << state.dt << " s against the stable limit " << state.stableDt
+        << " s is the usual cause; ";
+    if (suggested > 0.0)
+        out << "use dt <= " << suggested << " (or dt = \"auto\")";
+    else
+        out << "use a smaller dt (or dt = \"auto\")";
+    out << ", or slow the boundary velocities, gravity or pressure.";
+    throw NumericalBlowUp(out.str(), state.step, culprit, suggested);
+}
+
+}  // namespace rend::sim

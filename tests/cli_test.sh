@@ -253,7 +253,7 @@ check "unstable stretch is caught" run 3 run scenes/stretch.toml --set time.dt=0
 check "unstable stretch is caught in frame 5" test "$(wc -l <"$tmp/guard/stats.csv")" -eq 5
 check "guard message names the growth" grep -q "kinetic energy grew" "$tmp/stderr"
 check "guard message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
-check "absurd gravity is caught without inf advice" run 3 run scenes/stretch.toml "${small[@]}" \
+check "absurd gravity is refused at load without inf advice" run 2 run scenes/stretch.toml "${small[@]}" \
     --set 'forces.gravity=[0,0,-1e300]' --renderer none --out "$tmp/gravity"
 check "absurd gravity message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
 

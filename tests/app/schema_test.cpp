@@ -53,9 +53,13 @@ TEST(SceneSchema, EveryTableKeyNamesADeclaredSection) {
         for (const scene::Param& p : section.keys) {
             const bool nested =
                 p.type == scene::ValueType::Table || p.type == scene::ValueType::Tables;
-            if (nested) EXPECT_NO_THROW(scene::sectionAt(p.section)) << p.key;
+            if (nested) {
+                EXPECT_NO_THROW(scene::sectionAt(p.section)) << p.key;
+            }
             EXPECT_FALSE(p.meaning.empty()) << section.path << "." << p.key;
-            if (!nested) EXPECT_FALSE(p.example.empty()) << section.path << "." << p.key;
+            if (!nested) {
+                EXPECT_FALSE(p.example.empty()) << section.path << "." << p.key;
+            }
         }
     }
 }

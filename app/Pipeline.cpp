@@ -382,9 +382,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             progress.frameDone(frame, membrane.time(), frameFiles.empty() ? "" : frameFiles[0]);
         }
         finish("ok");
-    } catch (const sim::NumericalBlowUp&) {
+    } catch (const sim::NumericalBlowUp& e) {
         finish("blow-up");
-        throw;
+        // Located at the time step, the value the advice is about.
+        throw sim::NumericalBlowUp(scene.locationOf("time.dt") + ": error: " + e.what(), e.step,
+                                   e.particle, e.suggestedDt);
     } catch (...) {
         folder.wrote(frameFiles);
         finishAfterFailure();

@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s\n", e.what());
         return 2;
     } catch (const rend::sim::NumericalBlowUp& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        std::fprintf(stderr, "%s\n", e.what());  // located by the pipeline
         return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

@@ -250,6 +250,7 @@ check "a rerun after a kill leaves no partial files" no_partial_files "$tmp/reru
 # the largest speed is 0.27 m/s, where it used to run to frame 8 and 176 m/s.
 check "unstable stretch is caught" run 3 run scenes/stretch.toml --set time.dt=0.0084 \
     --set time.allow_unstable=true --renderer none --out "$tmp/guard"
+check "blow-up located at time.dt" grep -q "^--set 'time.dt=0.0084': error: numerical blow-up" "$tmp/stderr"
 check "unstable stretch is caught in frame 5" test "$(wc -l <"$tmp/guard/stats.csv")" -eq 5
 check "guard message names the growth" grep -q "kinetic energy grew" "$tmp/stderr"
 check "guard message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"

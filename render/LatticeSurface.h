@@ -30,7 +30,7 @@ public:
     /// (a square lattice with R < sqrt(2) dx has no diagonal bonds) never drops its triangle.
     explicit LatticeSurface(const sim::FrameView& rest);
 
-    /// Triangles whose three edge bonds are intact, with vertices duplicated along cracks
+    /// The frame's kept triangles (FrameView::keptTriangles), with vertices duplicated along cracks
     /// (see above), smooth (area-weighted) normals per vertex and per-vertex colours from the
     /// settings' ColorBy.
     ///
@@ -61,7 +61,6 @@ private:
     int cornerOf(int triangle, int particle) const;
 
     std::vector<std::array<int, 3>> triangles_;
-    std::vector<std::array<int, 3>> edgeBonds_;  ///< bond index per edge (i->j), -1 if none
     /// Triangle across edge e (corners e, e+1) of each triangle; -1 on the rest boundary.
     std::vector<std::array<int, 3>> edgeNeighbours_;
     /// Triangles incident to particle i: incident_[incidentOffsets_[i] .. [i + 1]), ascending.

@@ -127,8 +127,8 @@ FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double th
         elements_.push_back({t, Dm.inverse(), area, index, {-1, -1, -1}});
     }
     findNeighbours();
-    alive_.assign(elements_.size(), 1);
-    triangleAlive_.assign(lattice.triangles.size(), 1);
+    elementOf_.assign(lattice.triangles.size(), -1);
+    for (int t = 0; t < int(elements_.size()); ++t) elementOf_[elements_[t].triangle] = t;
     std::vector<std::array<int, 3>> kept;
     for (const Element& e : elements_) kept.push_back(e.v);
     triangleIncidence(kept, int(p.size()), cornerOffsets_, corners_);
@@ -138,6 +138,7 @@ FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double th
         plasticStrain_.assign(elements_.size(), Eigen::Matrix2d::Zero());
         maxStrain_.assign(elements_.size(), 0.0);
     }
+    bindOwn({}, int(p.size()), lattice.triangles);
 }
 
 void FemCst::findNeighbours() {
@@ -182,7 +183,7 @@ double FemCst::elementPass(const std::vector<Eigen::Vector3d>& x,
                                                     : lowest) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {
         const Element& e = elements_[t];
-        if (!alive_[t]) {
+        if (!elementAlive(t)) {
             cornerForce_[3 * t] = cornerForce_[3 * t + 1] = cornerForce_[3 * t + 2] =
                 Eigen::Vector3d::Zero();
             continue;
@@ -256,13 +257,14 @@ double FemCst::thetaOf(const Element& e) const {
     return (theta_[e.v[0]] + theta_[e.v[1]] + theta_[e.v[2]]) / 3.0;
 }
 
-void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
-    alive_[t] = 0;
-    triangleAlive_[elements_[t].triangle] = 0;
+void FemCst::erode(int t, bool breakSides) {
+    const int triangle = elements_[t].triangle;
+    damage_->removeTriangle(triangle);
+    if (!breakSides) return;
     for (int s = 0; s < 3; ++s) {  // a side comes apart once no living element holds it
         const int other = elements_[t].across[s];
-        if (other >= 0 && alive_[other]) continue;
-        apart.push_back({elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]});
+        if (other >= 0 && elementAlive(other)) continue;
+        damage_->breakEdge(damage_->triangleEdges(triangle)[s]);
     }
 }
 
@@ -340,46 +342,47 @@ bool FemCst::pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) co
     return centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1);
 }
 
-void FemCst::erodeFlagged(std::vector<std::array<int, 2>>& apart) {
+void FemCst::erodeFlagged() {
     for (int t = 0; t < int(elements_.size()); ++t)
         if (eroding_[t]) {
             eroding_[t] = 0;
-            erode(t, apart);
+            erode(t, true);
         }
 }
 
-std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
-    std::vector<std::array<int, 2>> apart;
+void FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
     const bool breakable = std::isfinite(criticalStrain_);
-    if (maxStrain_.empty() && !breakable) return apart;
+    if (maxStrain_.empty() && !breakable) return;
     const int elements = int(elements_.size());
 #pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {  // each element's own history and flag
-        if (!alive_[t]) continue;
+        if (!elementAlive(t)) continue;
         const double stretch = 1.0 + expansion_ * thetaOf(elements_[t]);
         if (!maxStrain_.empty())
             yieldElement(t, stretchesOf(deformationGradient(elements_[t], x) / stretch));
         if (breakable && pastCriticalStrain(t, x)) eroding_[t] = 1;
     }
-    erodeFlagged(apart);
-    return apart;
+    erodeFlagged();
 }
 
-bool FemCst::cut(const std::vector<std::array<int, 2>>& edges) {
-    std::map<std::pair<int, int>, bool> isCut;
-    for (const auto& [a, b] : edges) isCut[std::minmax(a, b)] = true;
-    std::vector<std::array<int, 2>> unused;
+void FemCst::cut(const std::vector<std::array<int, 2>>&) {
+    // The notches broke their edges in the DamageState; an element with one of them as a side
+    // goes, its other sides stay whole (the bonds along them still diffuse). Flag first, so the
+    // elements removed do not depend on the order.
     for (int t = 0; t < int(elements_.size()); ++t)
-        for (int s = 0; s < 3 && alive_[t]; ++s)
-            if (isCut.count(std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3])))
-                erode(t, unused);
-    return true;
+        for (const int e : damage_->triangleEdges(elements_[t].triangle))
+            if (!damage_->edgeIntact(e)) eroding_[t] = 1;
+    for (int t = 0; t < int(elements_.size()); ++t)
+        if (eroding_[t]) {
+            eroding_[t] = 0;
+            erode(t, false);
+        }
 }
 
 double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     for (int t = 0; t < int(elements_.size()); ++t) {
-        if (!alive_[t]) continue;
+        if (!elementAlive(t)) continue;
         const double theta = thetaOf(elements_[t]), stretch = 1.0 + expansion_ * theta;
         const Eigen::Matrix2d E =
             0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
@@ -397,56 +400,42 @@ double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     return sum;
 }
 
-std::vector<std::array<int, 2>> FemCst::advance(const std::vector<Eigen::Vector3d>& x,
-                                                const std::vector<Eigen::Vector3d>& v, double dt,
-                                                std::vector<Eigen::Vector3d>& force) {
-    std::vector<std::array<int, 2>> apart;
+void FemCst::advance(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v,
+                     double dt, std::vector<Eigen::Vector3d>& force) {
     const double lowest = elementPass<true>(x, force, &v, dt);
-    erodeFlagged(apart);
+    erodeFlagged();
     // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
     stiffening_ = law_.kind == BondLawKind::PowerLaw
                       ? std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)))
                       : 1.0;
-    return apart;
 }
 
 double FemCst::strengthLeft(int t) const {
     return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t]});
 }
 
-void FemCst::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
-    bondEnds_.clear();
-    bondElements_.clear();
+void FemCst::reportStrength(DamageState& damage) const {
     if (maxStrain_.empty()) return;  // only the elastoplastic law loses strength
-    std::map<std::pair<int, int>, std::array<int, 2>> holders;  // side -> its elements
-    for (int t = 0; t < int(elements_.size()); ++t)
-        for (int s = 0; s < 3; ++s) {
-            const auto key = std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]);
-            holders.try_emplace(key, std::array<int, 2>{t, elements_[t].across[s]});
-        }
-    bondEnds_.resize(partners.size());
-    bondElements_.assign(partners.size(), {-1, -1});
-    for (int i = 0; i + 1 < int(offsets.size()); ++i)
-        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
-            bondEnds_[b] = {i, partners[b]};
-            if (const auto it = holders.find(std::minmax(i, partners[b])); it != holders.end())
-                bondElements_[b] = it->second;
-        }
+    const BondFamilies& bonds = *sharedBonds_;
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+            damage.weaken(b, bondStrength(b, i, bonds.partners[b]));
 }
 
-double FemCst::bondStrengthLeft(int bond) const {
-    if (bondEnds_.empty()) return 1.0;
+double FemCst::bondStrength(int b, int i, int j) const {
     double sum = 0.0;
     int count = 0;
-    for (int t : bondElements_[bond])
-        if (t >= 0 && alive_[t]) sum += strengthLeft(t), ++count;
+    if (const int edge = damage_->bondEdge(b); edge >= 0)
+        for (int triangle : damage_->edgeTriangles(edge))
+            if (const int t = triangle >= 0 ? elementOf_[triangle] : -1; t >= 0 && elementAlive(t))
+                sum += strengthLeft(t), ++count;
     if (count > 0) return sum / count;
     double ends = 0.0;
-    for (int i : bondEnds_[bond]) {  // a bond no element side carries: its ends' mean
+    for (int end : {i, j}) {  // a bond no element side carries: its ends' mean
         double own = 0.0;
         int held = 0;
-        for (int k = cornerOffsets_[i]; k < cornerOffsets_[i + 1]; ++k)
-            if (const int t = corners_[k] / 3; alive_[t]) own += strengthLeft(t), ++held;
+        for (int k = cornerOffsets_[end]; k < cornerOffsets_[end + 1]; ++k)
+            if (const int t = corners_[k] / 3; elementAlive(t)) own += strengthLeft(t), ++held;
         ends += held > 0 ? own / held : 1.0;
     }
     return 0.5 * ends;

@@ -58,20 +58,17 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
     /// Yields the elastoplastic elements (their history step), then erodes.
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    void fracture(const std::vector<Eigen::Vector3d>& x) override;
     /// fracture(), forces(), and for the power law the stiffening of the most compressed
     /// principal stretch, looked ahead by dt at its current rate.
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
+    void advance(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v,
+                 double dt, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
     /// A bond along an element side: the mean gamma of the living elements holding it; any
     /// other bond: the mean of its two ends' (each the mean over its living elements).
-    double bondStrengthLeft(int bond) const override;
-    void bindBonds(std::span<const int> offsets, std::span<const int> partners) override;
+    void reportStrength(DamageState& damage) const override;
     /// A notch removes every element with a cut side (a gap one element wide).
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
-    std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
+    void cut(const std::vector<std::array<int, 2>>& edges) override;
 
     /// Green strain of triangle t at positions x, in its rest frame (first axis along edge 01).
     Eigen::Matrix2d greenStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
@@ -92,8 +89,12 @@ private:
     void findNeighbours();
     /// Mean theta over the element's corners (0 without diffusion).
     double thetaOf(const Element& e) const;
-    /// Removes element t and returns the sides no living element holds any more.
-    void erode(int t, std::vector<std::array<int, 2>>& apart);
+    /// Removes element t's triangle from the DamageState, and with `breakSides` breaks the
+    /// sides no living element holds any more.
+    void erode(int t, bool breakSides);
+    bool elementAlive(int t) const { return damage_->triangleAlive()[elements_[t].triangle]; }
+    /// eq. 27's gamma of bond b from i to j (see reportStrength()).
+    double bondStrength(int b, int i, int j) const;
     Eigen::Matrix<double, 3, 2> deformationGradient(const Element& e,
                                                     const std::vector<Eigen::Vector3d>& x) const;
     /// Power law and elastoplastic: the second Piola stress S of element t at the mechanical
@@ -125,9 +126,9 @@ private:
     /// Whether element t is past the critical strain at x: its largest principal Green strain
     /// of the mechanical part against the critical stretch's, both weakened by theta.
     bool pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
-    /// Removes the flagged elements in index order (so the sides reported do not depend on
+    /// Removes the flagged elements in index order (so the sides broken do not depend on
     /// the thread count) and clears the flags.
-    void erodeFlagged(std::vector<std::array<int, 2>>& apart);
+    void erodeFlagged();
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each
@@ -142,10 +143,7 @@ private:
     std::vector<double> maxStrain_;
     double stiffening_ = 1.0;
     std::vector<std::uint8_t> eroding_;  ///< per element: past the critical strain this step
-    // bindBonds: per bond, its ends and the elements holding it as a side (-1: none).
-    std::vector<std::array<int, 2>> bondEnds_, bondElements_;
-    std::vector<std::uint8_t> alive_;          ///< per element
-    std::vector<std::uint8_t> triangleAlive_;  ///< per lattice triangle, for the FrameView
+    std::vector<int> elementOf_;         ///< per lattice triangle, its element or -1 (degenerate)
 };
 
 /// Per particle, the corners (element * 3 + corner) of the triangles that contain it, in CSR.

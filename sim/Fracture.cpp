@@ -46,20 +46,17 @@ bool crossesAnyNotch(const Eigen::Vector2d& p, const Eigen::Vector2d& q,
 
 }  // namespace
 
-std::size_t applyNotches(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
-                         BondFamilies& bonds) {
-    std::size_t broken = 0;
+std::vector<int> notchedBonds(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
+                              const BondFamilies& bonds) {
+    std::vector<int> crossing;
     for (int i = 0; i < bonds.particleCount(); ++i)
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
             // Both copies of a bond are tested with the lower index first, so they agree even
             // where the tie-break of segmentsCross decides.
             if (const int lo = std::min(i, bonds.partners[b]), hi = std::max(i, bonds.partners[b]);
-                bonds.alive[b] &&
-                crossesAnyNotch(rest[lo].head<2>(), rest[hi].head<2>(), notches)) {
-                bonds.alive[b] = 0;
-                ++broken;
-            }
-    return broken / 2;  // each bond is stored from both ends, and both ends cross alike
+                crossesAnyNotch(rest[lo].head<2>(), rest[hi].head<2>(), notches))
+                crossing.push_back(b);
+    return crossing;
 }
 
 }  // namespace rend::sim

@@ -35,9 +35,8 @@ double paperCriticalStretch(double fractureEnergy, double youngsModulus, double 
 bool segmentsCross(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& a,
                    const Eigen::Vector2d& b);
 
-/// Breaks (both copies of) every bond whose rest segment crosses a notch. Returns the number
-/// of bonds broken.
-std::size_t applyNotches(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
-                         BondFamilies& bonds);
+/// Both copies of every bond whose rest segment crosses a notch, in index order.
+std::vector<int> notchedBonds(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
+                              const BondFamilies& bonds);
 
 }  // namespace rend::sim

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 #include <stdexcept>
 
 #include "sim/Parallel.h"
@@ -31,7 +30,7 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         return it->second;
     };
     for (const auto& v : lattice.triangles) {
-        Triangle tri{v, {}, {}, 0.0, 0.0};
+        Triangle tri{v, {}, {}, 0.0, 0.0, int(&v - lattice.triangles.data())};
         for (int s = 0; s < 3; ++s) {
             const int a = v[(s + 1) % 3], b = v[(s + 2) % 3];
             tri.side[s] = springOf(a, b);
@@ -64,61 +63,45 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
     }
     tension_.resize(springs_.size());
     triangleTension_.resize(triangles_.size());
-    springAlive_.assign(springs_.size(), 1);
     if (material.law == BondLawKind::Elastoplastic) plastic_.assign(springs_.size(), {});
-    triangleIntact_.assign(triangles_.size(), 1);
-    springTriangles_.assign(springs_.size(), {-1, -1});
-    for (int k = 0; k < int(triangles_.size()); ++k)
-        for (int side : triangles_[k].side)
-            springTriangles_[side][springTriangles_[side][0] >= 0] = k;
+    bindOwn({}, n, lattice.triangles);
 }
 
-void MassSpring::breakSpring(int s) {
-    springAlive_[s] = 0;
-    for (int k : springTriangles_[s])
-        if (k >= 0) triangleIntact_[k] = 0;
+void MassSpring::onBind() {
+    const auto& edges = damage_->edges();
+    bool same = edges.size() == springs_.size();
+    for (std::size_t s = 0; same && s < springs_.size(); ++s)
+        same = edges[s] == std::array<int, 2>{springs_[s].i, springs_[s].j};
+    if (!same) throw std::logic_error("the springs are not the damage state's edges");
 }
 
-std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
-    std::vector<std::array<int, 2>> apart;
-    if (plastic_.empty() && !std::isfinite(criticalStrain_)) return apart;  // nothing to record
+void MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
+    if (plastic_.empty() && !std::isfinite(criticalStrain_)) return;  // nothing to record
     for (int s = 0; s < int(springs_.size()); ++s) {
-        if (!springAlive_[s]) continue;
+        if (!springAlive(s)) continue;
         double thetaBar;
         const double eta = mechanicalStrain(s, x, thetaBar);
         if (!plastic_.empty()) plastic_[s] = law_.yieldStep(eta, plastic_[s]);  // eq. 20
         if (!(eta > criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar))) continue;
-        breakSpring(s);
-        apart.push_back({springs_[s].i, springs_[s].j});
+        damage_->breakEdge(s);  // serial, in spring order
     }
-    return apart;
 }
 
-std::vector<std::array<int, 2>> MassSpring::advance(const std::vector<Eigen::Vector3d>& x,
-                                                    const std::vector<Eigen::Vector3d>& v,
-                                                    double dt,
-                                                    std::vector<Eigen::Vector3d>& force) {
-    std::vector<std::array<int, 2>> apart = fracture(x);
+void MassSpring::advance(const std::vector<Eigen::Vector3d>& x,
+                         const std::vector<Eigen::Vector3d>& v, double dt,
+                         std::vector<Eigen::Vector3d>& force) {
+    fracture(x);
     if (law_.kind == BondLawKind::PowerLaw)  // the clamp is the peridynamic loop's
         stiffening_ =
             std::max(1.0, law_.powerLawStiffening(std::max(lowestStrain(x, v, dt), -0.95)));
     forces(x, force);
-    return apart;
 }
 
-void MassSpring::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
-    bondSpring_.assign(partners.size(), -1);
-    for (int s = 0; s < int(springs_.size()); ++s)
-        for (const auto& [a, b] :
-             {std::pair{springs_[s].i, springs_[s].j}, std::pair{springs_[s].j, springs_[s].i}})
-            for (int bond = offsets[a]; bond < offsets[a + 1]; ++bond)
-                if (partners[bond] == b) bondSpring_[bond] = s;
-}
-
-double MassSpring::bondStrengthLeft(int bond) const {
-    if (plastic_.empty() || bondSpring_.empty()) return 1.0;
-    const int s = bondSpring_[bond];
-    return s < 0 ? 1.0 : law_.strengthLeft(plastic_[s]);  // eq. 27's gamma of the side strain
+void MassSpring::reportStrength(DamageState& damage) const {
+    if (plastic_.empty()) return;
+    for (int b = 0; b < int(damage.bondAlive().size()); ++b)
+        if (const int s = damage.bondEdge(b); s >= 0)
+            damage.weaken(b, law_.strengthLeft(plastic_[s]));  // eq. 27's gamma of the side
 }
 
 double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
@@ -127,7 +110,7 @@ double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
     const int count = int(springs_.size());
 #pragma omp parallel for schedule(static) reduction(min : lowest) if (count >= kParallelThreshold)
     for (int s = 0; s < count; ++s) {
-        if (!springAlive_[s]) continue;
+        if (!springAlive(s)) continue;
         double thetaBar;
         const double eta = mechanicalStrain(s, x, thetaBar);
         if (eta >= 0.0) continue;
@@ -137,14 +120,6 @@ double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
         lowest = std::min(lowest, eta + std::min(0.0, dt * rate));
     }
     return lowest;
-}
-
-bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
-    std::set<std::pair<int, int>> cuts;  // springs are stored with i < j
-    for (const auto& [a, b] : edges) cuts.insert(std::minmax(a, b));
-    for (int s = 0; s < int(springs_.size()); ++s)
-        if (cuts.count({springs_[s].i, springs_[s].j})) breakSpring(s);
-    return true;
 }
 
 double MassSpring::mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x,
@@ -159,7 +134,7 @@ void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
     if (model_ == SpringModel::VanGelder) {
 #pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
         for (int s = 0; s < count; ++s) {
-            if (!springAlive_[s]) {
+            if (!springAlive(s)) {
                 tension_[s] = 0.0;
                 continue;
             }
@@ -217,7 +192,7 @@ void MassSpring::twoParameterTensions(const std::vector<Eigen::Vector3d>& x) con
 #pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
     for (int k = 0; k < triangles; ++k) {
         const Triangle& tri = triangles_[k];
-        if (!triangleIntact_[k]) {
+        if (!damage_->keptTriangles()[tri.triangle]) {
             triangleTension_[k] = {0.0, 0.0, 0.0};
             continue;
         }
@@ -312,7 +287,7 @@ double MassSpring::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     if (model_ == SpringModel::VanGelder) {  // k L0^2 Psi(eta), Psi the law's energy at c = 1
         for (int s = 0; s < int(springs_.size()); ++s) {
-            if (!springAlive_[s]) continue;
+            if (!springAlive(s)) continue;
             double thetaBar;
             const double eta = mechanicalStrain(s, x, thetaBar);
             const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[s];

@@ -68,15 +68,12 @@ public:
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
+    void fracture(const std::vector<Eigen::Vector3d>& x) override;
+    void advance(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v,
+                 double dt, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
     /// Each of the Membrane's bonds along a spring reports that spring's strength left.
-    void bindBonds(std::span<const int> offsets, std::span<const int> partners) override;
-    double bondStrengthLeft(int bond) const override;
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
+    void reportStrength(DamageState& damage) const override;
 
     int springCount() const { return int(springs_.size()); }
     /// Van Gelder's k of spring s (eq. 1) [N/m].
@@ -94,6 +91,7 @@ private:
         std::array<double, 3> restLength;
         double restArea;
         double fixedPart;  ///< Q (eq. 12)
+        int triangle;      ///< index into the lattice's triangles
     };
     /// Tension of every spring [N] at x.
     void tensions(const std::vector<Eigen::Vector3d>& x) const;
@@ -117,9 +115,12 @@ private:
     double lowestStrain(const std::vector<Eigen::Vector3d>& x,
                         const std::vector<Eigen::Vector3d>& v, double dt) const;
 
-    /// A broken spring carries nothing; a two-parameter triangle with a broken side carries
-    /// nothing either (its sides' forces are coupled through its shape).
-    void breakSpring(int s);
+    /// Spring s is the DamageState's edge s (both are numbered over the triangles' sides in
+    /// order). A broken spring carries nothing; a two-parameter triangle with a broken side is
+    /// no longer kept and carries nothing either (its sides' forces are coupled through its
+    /// shape).
+    bool springAlive(int s) const { return damage_->edgeIntact(s); }
+    void onBind() override;
 
     /// Mechanical strain of spring s at x (thermal strain removed) and its theta_bar.
     double mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x, double& thetaBar) const;
@@ -129,11 +130,8 @@ private:
     BondLaw law_;  ///< the material's law with c = 1: tension = k L0 f(eta)
     double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
     std::vector<PlasticState> plastic_;  ///< per spring; empty unless elastoplastic
-    std::vector<int> bondSpring_;        ///< per directed bond of the Membrane, its spring or -1
     double stiffening_ = 1.0;
     double criticalStrain_;
-    std::vector<std::uint8_t> springAlive_, triangleIntact_;
-    std::vector<std::array<int, 2>> springTriangles_;  ///< the (one or two) triangles of a spring
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;
     // Per particle, its springs (signed: +s+1 when it is end i, -(s+1) when end j), so each

@@ -16,6 +16,7 @@
 
 #include "sim/BondLaw.h"
 #include "sim/Bonds.h"
+#include "sim/DamageState.h"
 #include "sim/Diffusion.h"
 #include "sim/FrameView.h"
 #include "sim/Lattice.h"
@@ -133,6 +134,8 @@ public:
     BondFamilies& bonds() { return bonds_; }
     const BondFamilies& bonds() const { return bonds_; }
     const Lattice& lattice() const { return lattice_; }
+    /// Which bonds are broken and triangles removed (sim/DamageState.h).
+    const DamageState& damageState() const { return damageState_; }
 
 private:
     static constexpr std::int16_t kFree = -1;
@@ -140,8 +143,6 @@ private:
 
     /// Stable step and runaway-speed limit from max_i k_i / m_i (Solver::stiffnessRowSums).
     void setStableStep(double worstRatio);
-    /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
-    void breakBond(int i, int j);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
     const PeridynamicBonds& peridynamicBonds() const;
@@ -167,6 +168,7 @@ private:
     MembraneParams params_;
     Lattice lattice_;
     BondFamilies bonds_;
+    DamageState damageState_;  ///< broken bonds, removed triangles: the one owner
     bool canDamage_ = false;
     std::size_t notched_ = 0;
     std::optional<Diffusion> diffusion_;
@@ -187,7 +189,6 @@ private:
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
-    std::vector<std::array<int, 3>> pressureEdgeBonds_;  ///< per rest triangle; empty if p = 0
     bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
 };
 

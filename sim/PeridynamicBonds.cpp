@@ -12,7 +12,7 @@
 namespace rend::sim {
 
 PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& lattice,
-                                   BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
+                                   const BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
                                    std::span<const double> volumes)
     : bonds_(bonds),
       rest_(rest),
@@ -126,27 +126,32 @@ double PeridynamicBonds::mechanicalStrain(int i, int b, double length, double& t
     return eta - material_.expansion * thetaBar;
 }
 
-// Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
-// Both copies of a bond see the same strain bit for bit, so they break and yield together.
+// Writes only particle i's force and its own copies of its bonds (plastic state, proposed
+// break), so the loop needs no atomics. Both copies of a bond see the same strain bit for bit,
+// so they break and yield together; a bond past its limit carries nothing already in this
+// step, so breaking after the loop gives the bits of breaking in place.
 template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
 void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
                                      std::vector<Eigen::Vector3d>& force) {
     const int n = bonds_.particleCount();
     force.resize(n);
-    // Raw arrays, loaded once: the stores to `alive` (a char type) and to `plastic` would
+    // Raw arrays, loaded once: the stores to `proposed` (a char type) and to `plastic` would
     // otherwise make the compiler reload every vector's data pointer after each of them.
     const int* offsets = bonds_.offsets.data();
     const int* partners = bonds_.partners.data();
     const double* restLength = bonds_.restLength.data();
     const double* bondScale = bondScale_.data();
-    std::uint8_t* alive = bonds_.alive.data();
+    const std::uint8_t* alive = damage_->bondAlive().data();
+    std::uint8_t* proposed = kUpdateBonds ? damage_->proposals() : nullptr;
     PlasticState* plastic = plastic_.data();
     const Eigen::Vector3d* xs = x.data();
     const double* theta = theta_.data();
     const Eigen::Vector3d* v = velocities_ ? velocities_->data() : nullptr;
     const MaterialParams& m = material_;
     double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
-#pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
+    int breaking = 0;
+#pragma omp parallel for schedule(static) reduction(min : lowest) reduction(+ : breaking) if ( \
+        n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         const Eigen::Vector3d xi = xs[i];
@@ -165,7 +170,7 @@ void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
                 double limit = criticalStretch_;
                 if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
                 if (eta > limit) {
-                    if constexpr (kUpdateBonds) alive[b] = 0;
+                    if constexpr (kUpdateBonds) proposed[b] = 1, ++breaking;
                     continue;
                 }
             }
@@ -186,6 +191,7 @@ void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
         }
         force[i] = sum;
     }
+    if (breaking > 0) damage_->applyProposals();
     if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw)
         stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
 }
@@ -217,21 +223,24 @@ void PeridynamicBonds::forces(const std::vector<Eigen::Vector3d>& x,
     const_cast<PeridynamicBonds*>(this)->bondForces<false>(x, force);
 }
 
-std::vector<std::array<int, 2>> PeridynamicBonds::advance(const std::vector<Eigen::Vector3d>& x,
-                                                          const std::vector<Eigen::Vector3d>& v,
-                                                          double dt,
-                                                          std::vector<Eigen::Vector3d>& force) {
+void PeridynamicBonds::advance(const std::vector<Eigen::Vector3d>& x,
+                               const std::vector<Eigen::Vector3d>& v, double dt,
+                               std::vector<Eigen::Vector3d>& force) {
     velocities_ = &v;
     dt_ = dt;
     bondForces<true>(x, force);
-    return {};  // the shared bonds broke in place
+}
+
+void PeridynamicBonds::reportStrength(DamageState& damage) const {
+    for (std::size_t b = 0; b < plastic_.size(); ++b)
+        damage.weaken(int(b), law_.strengthLeft(plastic_[b]));  // eq. 27
 }
 
 double PeridynamicBonds::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
     double sum = 0.0;
     for (int i = 0; i < bonds_.particleCount(); ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-            if (!bonds_.alive[b]) continue;
+            if (!damage_->bondAlive()[b]) continue;
             double thetaBar;
             const double length = (x[bonds_.partners[b]] - x[i]).norm();
             const double eta = mechanicalStrain(i, b, length, thetaBar);
@@ -247,7 +256,7 @@ Eigen::Matrix3d PeridynamicBonds::particleStress(int i,
                                                  const std::vector<Eigen::Vector3d>& x) const {
     Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
     for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-        if (!bonds_.alive[b]) continue;
+        if (!damage_->bondAlive()[b]) continue;
         const Eigen::Vector3d r = x[bonds_.partners[b]] - x[i];
         const double length = r.norm();
         double thetaBar;

@@ -3,7 +3,8 @@
 // a Solver: every pair within the horizon R is a bond with one of the three laws (eqs. 18-20),
 // broken for good past the critical stretch (eqs. 27-28), strained and weakened by the
 // diffusing theta. The bonds are the Membrane's own BondFamilies (diffusion and the FrameView
-// read them too), so a bond breaks in place and advance() returns no edges.
+// read them too); the force loop proposes the bonds past their limit to the DamageState, which
+// breaks them after the loop (sim/DamageState.h).
 //
 // The force loop is compiled once per law and per whether theta exists and bonds can break,
 // so a stage a scene does not need costs nothing per bond; advance() fuses fracture, yield and
@@ -23,24 +24,21 @@ namespace rend::sim {
 
 class PeridynamicBonds final : public Solver {
 public:
-    /// `bonds` is the Membrane's (kept by reference; notches are applied to it by the caller),
-    /// `rest` and `volumes` its rest positions and particle volumes.
-    PeridynamicBonds(const MembraneParams& params, const Lattice& lattice, BondFamilies& bonds,
-                     std::span<const Eigen::Vector3d> rest, std::span<const double> volumes);
+    /// `bonds` is the Membrane's (kept by reference), `rest` and `volumes` its rest positions
+    /// and particle volumes. Bind it (Solver::bind) to a DamageState over the same bonds before
+    /// use.
+    PeridynamicBonds(const MembraneParams& params, const Lattice& lattice,
+                     const BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
+                     std::span<const double> volumes);
 
     void forces(const std::vector<Eigen::Vector3d>& x,
                 std::vector<Eigen::Vector3d>& force) const override;
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
+    void advance(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v,
+                 double dt, std::vector<Eigen::Vector3d>& force) override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
-    /// Notches already broke the shared bonds they cross.
-    bool cut(const std::vector<std::array<int, 2>>&) override { return true; }
     double stiffening() const override { return stiffening_; }
-    double bondStrengthLeft(int bond) const override {
-        return plastic_.empty() ? 1.0 : law_.strengthLeft(plastic_[bond]);  // eq. 27
-    }
+    void reportStrength(DamageState& damage) const override;
 
     const BondLaw& law() const { return law_; }
     /// eta_c at theta = 0; +infinity when the material has no fracture energy.
@@ -63,7 +61,7 @@ private:
         return std::max(0.0, 1.0 - loss * thetaBar);
     }
 
-    BondFamilies& bonds_;
+    const BondFamilies& bonds_;
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     MaterialParams material_;

@@ -52,7 +52,8 @@ TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
     mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
     const int n = int(rest_.size());
     pairs_ = buildBondFamilies(rest_, support_);
-    applyNotches(notches, rest_, pairs_);
+    pairAlive_.assign(pairs_.directedCount(), 1);
+    for (const int k : notchedBonds(notches, rest_, pairs_)) pairAlive_[k] = 0;
     offsets_ = pairs_.offsets;
     neighbours_ = pairs_.partners;
     volume_.assign(n, lattice.particleArea);
@@ -66,30 +67,25 @@ TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
     stress_.resize(n);
     restMetric_.assign(n, -1);
     breaking_.assign(neighbours_.size(), 0);
-    // The pairs that are also sides of rest triangles: their breaking is reported to Membrane
-    // (the FrameView's cracks) and removes the triangles on either side.
-    latticeEdge_.assign(neighbours_.size(), 0);
-    triangleSidePairs_.reserve(lattice.triangles.size());
-    for (const auto& t : lattice.triangles) {
-        std::array<int, 3> side{};
-        for (int s = 0; s < 3; ++s) {
-            const int a = t[(s + 1) % 3], b = t[(s + 2) % 3];
-            side[s] = findBond(pairs_, a, b);
-            if (side[s] >= 0) latticeEdge_[side[s]] = latticeEdge_[mirror_[side[s]]] = 1;
-        }
-        triangleSidePairs_.push_back(side);
-    }
-    if (std::isfinite(criticalStrain_)) triangleAlive_.assign(lattice.triangles.size(), 1);
+    bindOwn({}, n, lattice.triangles);
+}
+
+void TotalLagrangianSph::onBind() {
+    // The pairs that are also sides of rest triangles (the FrameView's cracks); set-up only.
+    pairEdge_.assign(neighbours_.size(), -1);
+    const auto& edges = damage_->edges();
+    for (int e = 0; e < int(edges.size()); ++e)
+        if (const int k = findBond(pairs_, edges[e][0], edges[e][1]); k >= 0)
+            pairEdge_[k] = pairEdge_[mirror_[k]] = e;
 }
 
 bool TotalLagrangianSph::pairAlive(int i, int j) const {
     const int k = findBond(pairs_, i, j);
-    return k >= 0 && pairs_.alive[k];
+    return k >= 0 && pairAlive_[k];
 }
 
-std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
-    const std::vector<Eigen::Vector3d>& x) {
-    if (!std::isfinite(criticalStrain_)) return {};
+void TotalLagrangianSph::fracture(const std::vector<Eigen::Vector3d>& x) {
+    if (!std::isfinite(criticalStrain_)) return;
     const int n = int(x.size());
     deformations(x);
     // The pair's stretch seen through the mean of its ends' mechanical F, not its own length:
@@ -102,7 +98,7 @@ std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
         const double si = 1.0 + expansion_ * thetaAt(i);
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             breaking_[k] = 0;
-            if (!pairs_.alive[k]) continue;
+            if (!pairAlive_[k]) continue;
             const int j = neighbours_[k];
             const double thetaBar = 0.5 * (thetaAt(i) + thetaAt(j));
             const Eigen::Vector2d d = (rest_[j] - rest_[i]).head<2>() / pairs_.restLength[k];
@@ -115,35 +111,32 @@ std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
             count += breaking_[k];
         }
     }
-    std::vector<std::array<int, 2>> apart;
-    if (count == 0) return apart;
+    if (count == 0) return;
     std::vector<int> touched;
     for (int i = 0; i < n; ++i)
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             if (breaking_[k]) {
                 breakPair(k, touched);
-                if (latticeEdge_[k] && i < neighbours_[k]) apart.push_back({i, neighbours_[k]});
+                if (pairEdge_[k] >= 0) damage_->breakEdge(pairEdge_[k]);  // in index order
             }
     settle(touched);
     for (int i : touched) deformation_[i] = deformationGradient(i, x);
-    return apart;
 }
 
-bool TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
+void TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
     // Without fracture the notches did it all at set-up, with their pairs re-corrected.
-    if (!std::isfinite(criticalStrain_)) return true;
+    if (!std::isfinite(criticalStrain_)) return;
     std::vector<int> touched;
     for (const auto& [i, j] : edges)
-        if (const int k = findBond(pairs_, i, j); k >= 0 && pairs_.alive[k]) {
+        if (const int k = findBond(pairs_, i, j); k >= 0 && pairAlive_[k]) {
             breakPair(k, touched);
             breakPair(mirror_[k], touched);
         }
     settle(touched);
-    return true;
 }
 
 void TotalLagrangianSph::breakPair(int k, std::vector<int>& touched) {
-    pairs_.alive[k] = 0;
+    pairAlive_[k] = 0;
     gradient_[k].setZero();
     const int i = int(std::upper_bound(offsets_.begin(), offsets_.end(), k) - offsets_.begin()) - 1;
     touched.push_back(i);
@@ -165,22 +158,17 @@ void TotalLagrangianSph::settle(std::vector<int>& touched) {
         }
         metric_[restMetric_[i]] = B.transpose() * B;
     }
-    for (std::size_t t = 0; t < triangleSidePairs_.size(); ++t)
-        for (int k : triangleSidePairs_[t])
-            if (k >= 0 && !pairs_.alive[k]) triangleAlive_[t] = 0;
 }
 
-std::vector<std::array<int, 2>> TotalLagrangianSph::advance(const std::vector<Eigen::Vector3d>& x,
-                                                            const std::vector<Eigen::Vector3d>&,
-                                                            double,
-                                                            std::vector<Eigen::Vector3d>& force) {
+void TotalLagrangianSph::advance(const std::vector<Eigen::Vector3d>& x,
+                                 const std::vector<Eigen::Vector3d>&, double,
+                                 std::vector<Eigen::Vector3d>& force) {
     if (!std::isfinite(criticalStrain_)) {
         forces(x, force);
-        return {};
+        return;
     }
-    std::vector<std::array<int, 2>> apart = fracture(x);  // leaves deformation_ at x
+    fracture(x);  // leaves deformation_ at x
     forcesFrom(force);
-    return apart;
 }
 
 void TotalLagrangianSph::deformations(const std::vector<Eigen::Vector3d>& x) const {
@@ -195,7 +183,7 @@ void TotalLagrangianSph::correctGradients(int i) {
     for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
         const Eigen::Vector2d d = (rest_[neighbours_[k]] - rest_[i]).head<2>();
         gradient_[k] =
-            pairs_.alive[k]
+            pairAlive_[k]
                 ? Eigen::Vector2d(volume_[neighbours_[k]] * kernel(d.norm(), support_) * d)
                 : Eigen::Vector2d::Zero();
         A += d * gradient_[k].transpose();

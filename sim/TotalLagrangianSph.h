@@ -27,7 +27,7 @@
 // pairs of d_ij g_ij^T: E = (F^T F - C0) / 2, so the rest state and rigid motions stay stress-free,
 // the stiffness across the crack fades with the pairs, no gradient grows, and a particle with no
 // pair left carries no stress. Forces stay the exact gradient. Pairs that are rest-lattice edges
-// are reported to Membrane and kill their triangles.
+// break their edge in the DamageState, which drops the triangles on either side.
 //
 // Why F and not the pair's own length: in crack_path_sources at dx = 0.04 (no fracture, 0.4 s)
 // the longest pair stretch next to the grips is 0.051 and 0.043 inside (FEM: 0.039 and 0.019),
@@ -66,13 +66,11 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
     /// Breaks the pairs {i, j} as fracture would (the notches' own were removed at set-up).
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    void cut(const std::vector<std::array<int, 2>>& edges) override;
+    void fracture(const std::vector<Eigen::Vector3d>& x) override;
     /// fracture() then the forces from the same deformation gradients.
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
-    std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
+    void advance(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v,
+                 double dt, std::vector<Eigen::Vector3d>& force) override;
 
     /// Pairs broken by fracture so far (each counted once; notches not included).
     std::size_t brokenPairCount() const { return brokenPairs_; }
@@ -93,8 +91,10 @@ private:
     void forcesFrom(std::vector<Eigen::Vector3d>& force) const;
     /// Drops the pair copy k's gradient; its particle goes into `touched`.
     void breakPair(int k, std::vector<int>& touched);
-    /// Rest metrics of the touched particles and the triangles that lost a side.
+    /// Rest metrics of the touched particles.
     void settle(std::vector<int>& touched);
+    /// The pairs along rest-lattice edges, whose breaking breaks the DamageState's edge.
+    void onBind() override;
     /// Corrected gradients of particle i over its living pairs; none when they no longer span
     /// the plane (the particle has broken loose and carries no stress).
     void correctGradients(int i);
@@ -102,7 +102,8 @@ private:
 
     // CSR neighbours of each particle with their corrected gradients g_ij; `mirror[k]` is the
     // index of the pair j -> i in j's list.
-    BondFamilies pairs_;  ///< rest neighbours within 2 dx, with alive flags
+    BondFamilies pairs_;                   ///< rest neighbours within 2 dx
+    std::vector<std::uint8_t> pairAlive_;  ///< per pair copy: 1 whole, 0 broken
     std::vector<int> offsets_, neighbours_, mirror_;
     std::vector<Eigen::Vector3d> rest_;
     double support_ = 0.0;
@@ -118,10 +119,8 @@ private:
     std::vector<std::int32_t> restMetric_;  ///< index into metric_ per particle, -1 undamaged
     std::vector<Eigen::Matrix2d> metric_;   ///< C0 of the damaged particles
     mutable std::vector<Eigen::Matrix<double, 3, 2>> deformation_;  ///< F_i at the last x
-    std::vector<std::uint8_t> breaking_;     ///< per pair copy, set by this step's check
-    std::vector<std::uint8_t> latticeEdge_;  ///< per pair copy: also a rest-lattice edge
-    std::vector<std::array<int, 3>> triangleSidePairs_;
-    std::vector<std::uint8_t> triangleAlive_;
+    std::vector<std::uint8_t> breaking_;  ///< per pair copy, set by this step's check
+    std::vector<int> pairEdge_;           ///< per pair copy: the DamageState's edge along it, or -1
     std::size_t brokenPairs_ = 0;
 };
 

@@ -149,7 +149,7 @@ TEST(Fracture, DamageNeverHeals) {
     p.boundaries = {top, bottom};
     p.time.dt = 2e-4;
     Membrane m(p);
-    std::vector<std::uint8_t> before = m.bonds().alive;
+    std::vector<std::uint8_t> before = m.damageState().bondAlive();
     std::size_t maxBroken = 0;
     for (int s = 0; s < 3000; ++s) {
         if (s == 1500) {  // push the edges back together: nothing may reconnect
@@ -157,8 +157,9 @@ TEST(Fracture, DamageNeverHeals) {
             p.boundaries[0].velocity *= -1.0;
         }
         m.step();
-        for (std::size_t b = 0; b < before.size(); ++b) ASSERT_LE(m.bonds().alive[b], before[b]);
-        before = m.bonds().alive;
+        for (std::size_t b = 0; b < before.size(); ++b)
+            ASSERT_LE(m.damageState().bondAlive()[b], before[b]);
+        before = m.damageState().bondAlive();
         maxBroken = std::max(maxBroken, m.brokenBondCount());
     }
     EXPECT_GT(m.brokenBondCount(), m.notchedBondCount()) << "the crack grew";
@@ -180,6 +181,7 @@ TEST(Fracture, ANotchBreaksExactlyTheBondsItCrosses) {
     p.notches = {Notch{{{-0.1, y}, {0.1, y}}}};
     Membrane m(p);
     const BondFamilies& bonds = m.bonds();
+    const std::vector<std::uint8_t>& bondAlive = m.damageState().bondAlive();
     std::size_t expected = 0;
     for (int i = 0; i < m.particleCount(); ++i)
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
@@ -189,7 +191,7 @@ TEST(Fracture, ANotchBreaksExactlyTheBondsItCrosses) {
             const bool straddles = (a.y() - y) * (c.y() - y) < 0.0;
             const double x = a.x() + (c.x() - a.x()) * (y - a.y()) / (c.y() - a.y());
             const bool crosses = straddles && x >= -0.1 && x <= 0.1;
-            EXPECT_EQ(bonds.alive[b] == 0, crosses) << i << " -> " << bonds.partners[b];
+            EXPECT_EQ(bondAlive[b] == 0, crosses) << i << " -> " << bonds.partners[b];
             expected += crosses;
         }
     EXPECT_EQ(m.notchedBondCount(), expected / 2);
@@ -208,6 +210,7 @@ TEST(Fracture, ANotchAlongAParticleRowCutsTheRowOffOnceAndLeavesNoLooseParticle)
     p.notches = {Notch{{{-0.105, 0.0}, {0.105, 0.0}}}};
     Membrane m(p);
     const BondFamilies& bonds = m.bonds();
+    const std::vector<std::uint8_t>& bondAlive = m.damageState().bondAlive();
     std::size_t expected = 0;
     for (int i = 0; i < m.particleCount(); ++i) {
         const Eigen::Vector3d a = m.restPositions()[i];
@@ -219,9 +222,9 @@ TEST(Fracture, ANotchAlongAParticleRowCutsTheRowOffOnceAndLeavesNoLooseParticle)
             // its upper end lies on the notch.
             const bool crosses =
                 std::abs(hi.y()) < 1e-12 && lo.y() < -1e-12 && std::abs(hi.x()) <= 0.105;
-            EXPECT_EQ(bonds.alive[b] == 0, crosses) << i << " -> " << bonds.partners[b];
+            EXPECT_EQ(bondAlive[b] == 0, crosses) << i << " -> " << bonds.partners[b];
             expected += crosses;
-            alive += bonds.alive[b];
+            alive += bondAlive[b];
         }
         EXPECT_GE(alive, 2) << "particle " << i << " was cut loose";
     }

@@ -16,6 +16,7 @@
 #include "sim/Membrane.h"
 #include "sim/PeridynamicBonds.h"
 #include "sim/Random.h"
+#include "tests/sim/ErodedElement.h"
 #include "tests/sim/ThreadCheck.h"
 
 using namespace rend::sim;
@@ -117,7 +118,7 @@ TEST(Solvers, BondFemAndSphForcesAreMinusTheGradientOfTheStrainEnergy) {
 
 TEST(Solvers, ThePeridynamicBondsAreASolverOnTheMembranesOwnBonds) {
     // The default solver is the paper's bonds behind the same interface: they break the shared
-    // bonds in place (advance() returns no edges), report the power law's stiffening in
+    // bonds through the DamageState it is bound to, report the power law's stiffening in
     // compression, and give the damage field eq. 27's strength left of yielded bonds.
     MembraneParams p = sheet(SolverKind::Peridynamic, 0.3, 0.2, 0.2);
     p.material.fractureEnergy = 0.02;
@@ -131,20 +132,25 @@ TEST(Solvers, ThePeridynamicBondsAreASolverOnTheMembranesOwnBonds) {
     const std::vector<double> volumes(lattice.positions.size(),
                                       lattice.particleArea * p.sheet.thickness);
     PeridynamicBonds solver(p, lattice, shared, lattice.positions, volumes);
+    DamageState damage(shared, lattice.triangles);
+    solver.bind(shared, damage);
     std::vector<Eigen::Vector3d> x = lattice.positions, v(x.size(), Eigen::Vector3d::Zero()), f;
     const double etaC = solver.criticalStretch();
     for (auto& xi : x) xi.x() *= 1.0 + 1.01 * etaC;  // every x-leaning bond past eta_c
     f.resize(x.size());
-    EXPECT_TRUE(solver.advance(x, v, 1e-3, f).empty());
-    const auto broken = std::count(shared.alive.begin(), shared.alive.end(), 0);
+    solver.advance(x, v, 1e-3, f);
+    const auto broken = std::count(damage.bondAlive().begin(), damage.bondAlive().end(), 0);
     EXPECT_GT(broken, 0);
+    EXPECT_EQ(std::size_t(broken), 2 * damage.brokenBondCount()) << "both copies break";
     for (auto& xi : x) xi.x() /= 1.0 + 1.01 * etaC;  // back to rest: nothing heals
     solver.advance(x, v, 1e-3, f);
-    EXPECT_EQ(std::count(shared.alive.begin(), shared.alive.end(), 0), broken);
+    EXPECT_EQ(std::count(damage.bondAlive().begin(), damage.bondAlive().end(), 0), broken);
 
     p.material.fractureEnergy.reset();
     p.material.law = BondLawKind::PowerLaw;
     PeridynamicBonds rubber(p, lattice, shared, lattice.positions, volumes);
+    DamageState intact(shared, lattice.triangles);
+    rubber.bind(shared, intact);
     x = lattice.positions;
     for (auto& xi : x) xi *= 0.8;
     rubber.advance(x, v, 1e-3, f);
@@ -312,12 +318,12 @@ TEST(Solvers, SpringsAndElementsBreakPastTheCriticalStrainAndNeverHeal) {
             m.updateDamage();
             for (double d : m.damage()) EXPECT_DOUBLE_EQ(d, 1.0) << solverName(s);
             const FrameView v = m.view(1);
-            if (s == SolverKind::FemCst) {
-                ASSERT_EQ(v.triangleAlive.size(), m.lattice().triangles.size());
-                for (auto alive : v.triangleAlive) EXPECT_EQ(alive, 0) << "eroded";
-            } else {
-                EXPECT_TRUE(v.triangleAlive.empty()) << solverName(s);
-            }
+            ASSERT_EQ(v.keptTriangles.size(), m.lattice().triangles.size());
+            for (auto kept : v.keptTriangles) EXPECT_EQ(kept, 0) << solverName(s);
+            // Only the FEM removes triangles (erodes elements); springs break edges.
+            EXPECT_EQ(m.damageState().removedTriangleCount(),
+                      s == SolverKind::FemCst ? m.lattice().triangles.size() : 0u)
+                << solverName(s);
         }
     }
 }
@@ -402,8 +408,10 @@ TEST(Solvers, AFemNotchRemovesTheElementsItCuts) {
     Membrane m(p);
     const FrameView v = m.view(1);
     std::size_t removed = 0;
-    for (std::size_t t = 0; t < v.triangleAlive.size(); ++t) {
-        if (v.triangleAlive[t]) continue;
+    const std::vector<std::uint8_t>& alive = m.damageState().triangleAlive();
+    for (std::size_t t = 0; t < alive.size(); ++t) {
+        if (alive[t]) continue;
+        EXPECT_FALSE(v.keptTriangles[t]);
         ++removed;
         bool cutSide = false;
         for (int e = 0; e < 3; ++e) {
@@ -459,4 +467,52 @@ TEST(Solvers, AnSphNotchRemovesThePairsThatCrossIt) {
             std::max(m.restPositions()[i].x() < -0.08 ? far : near, f[i].norm());
     EXPECT_LT(far, 1e-12) << "no pair bridges the notch";
     EXPECT_GT(near, 1e-6) << "beyond the tip the sheet is whole";
+}
+
+TEST(Damage, AnErodedElementTakesNoPressureThoughItsSidesAreIntact) {
+    const MembraneParams p = rend::test::erodingSheet(10.0);
+    Membrane m(p);
+    const int t = rend::test::erodeOneElement(m, p);
+    const DamageState& damage = m.damageState();
+    ASSERT_EQ(damage.removedTriangleCount(), 1u);
+    ASSERT_FALSE(damage.triangleAlive()[t]);
+    for (int e : damage.triangleEdges(t)) ASSERT_TRUE(damage.edgeIntact(e)) << "neighbours hold it";
+    EXPECT_FALSE(m.view(1).keptTriangles[t]);
+    support::expectConsistentDamage(m);
+
+    // Internal forces sum to zero, so one more step gains dt times the pressure on the kept
+    // triangles at x^n (symplectic Euler, no gravity, no grips).
+    const std::vector<Eigen::Vector3d> x = std::as_const(m).positions();
+    const Eigen::Vector3d before = m.totalMomentum();
+    m.step();
+    ASSERT_EQ(damage.removedTriangleCount(), 1u);
+    Eigen::Vector3d kept = Eigen::Vector3d::Zero(), all = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < m.lattice().triangles.size(); ++k) {
+        const auto [a, b, c] = m.lattice().triangles[k];
+        const Eigen::Vector3d push = p.pressure * 0.5 * (x[b] - x[a]).cross(x[c] - x[a]);
+        all += push;
+        if (damage.keptTriangles()[k]) kept += push;
+    }
+    const Eigen::Vector3d gained = (m.totalMomentum() - before) / *p.time.dt;
+    EXPECT_NEAR((gained - kept).norm(), 0.0, 1e-9 * kept.norm());
+    EXPECT_GT((all - kept).norm(), 1e-3 * kept.norm()) << "the element would have taken a share";
+}
+
+TEST(Damage, EverySolverBreaksOnlyThroughTheDamageState) {
+    // A notched sheet pulled apart: whatever each solver breaks (bonds, springs, elements,
+    // pairs) shows in the one DamageState, consistently, and 1 and 2 threads agree on it.
+    for (SolverKind s : kSolvers) {
+        MembraneParams p = sheet(s, 0.3, 1.0, 1.0);
+        p.material.fractureEnergy = 0.02;
+        p.boundaries = support::pullingGrips();
+        p.notches = {Notch{{{-0.2, 0.011}, {0.0, 0.011}}}};
+        SCOPED_TRACE(solverName(s));
+        Membrane m(p);
+        support::expectConsistentDamage(m);
+        const std::size_t notched = m.brokenBondCount();
+        EXPECT_GT(notched, 0u);
+        for (int k = 0; k < 300; ++k) m.step();
+        support::expectConsistentDamage(m);
+        EXPECT_GT(m.brokenBondCount(), notched) << "the crack grew";
+    }
 }

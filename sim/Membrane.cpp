@@ -6,11 +6,9 @@
 #include <limits>
 #include <sstream>
 
-#include "sim/FemCst.h"
 #include "sim/Fracture.h"
-#include "sim/MassSpring.h"
-#include "sim/PeridynamicBonds.h"
-#include "sim/TotalLagrangianSph.h"
+#include "sim/Material.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 
@@ -28,10 +26,8 @@ Membrane::Membrane(const MembraneParams& params)
     for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
     damageState_ = DamageState(bonds_, lattice_.triangles);
-    if (params.solver == SolverKind::Peridynamic)
-        useSolver(std::make_unique<PeridynamicBonds>(params, lattice_, bonds_, x0_, volume_));
-    else
-        useSolver(makeSolver(params, lattice_));
+    const Material material(params.material);  // validated once, for every solver
+    useSolver(solverEntry(params.solver).make({params, material, lattice_, bonds_, x0_, volume_}));
     setUpNotches(params);
     assignBoundaries();
     x_ = x0_;
@@ -58,67 +54,15 @@ void Membrane::setStableStep(double worstRatio) {
                   2.0 * params_.gravity.norm() * params_.time.duration + 1e-6;
 }
 
-double springCriticalStrain(const MembraneParams& params) {
-    const MaterialParams& m = params.material;
-    if (!m.fractureEnergy) return std::numeric_limits<double>::infinity();
-    // The springs crossing a unit length of crack along a hexagonal row (2 / dx of them, each
-    // sqrt(3)/2 E h at nu = 1/3) store G_f h at this strain: k eps^2 dx^2 / 2 * 2 / dx = G_f h.
-    return std::sqrt(2.0 * *m.fractureEnergy /
-                     (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
-}
-
-double bandCriticalStrain(const MembraneParams& params) {
-    // An eroded element (or a two-parameter triangle with a broken side) releases only its own
-    // energy: the band the crack takes out, sqrt(3)/2 dx high, at E eps^2 / (2 (1 - nu^2)),
-    // holds G_f h per unit length at sqrt(2 (1 - nu^2)) times the springs' strain.
-    const double nu = params.material.poissonRatio;
-    return std::sqrt(2.0 * (1.0 - nu * nu)) * springCriticalStrain(params);
-}
-
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
-    const MaterialParams& m = params.material;
-    const double h = params.sheet.thickness;
-    const double critical = springCriticalStrain(params);
-    switch (params.solver) {
-        case SolverKind::FemCst:
-            return std::make_unique<FemCst>(lattice, m, h, bandCriticalStrain(params));
-        case SolverKind::MassSpringVanGelder:
-            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
-        case SolverKind::MassSpringTwoParameter:
-            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h,
-                                                bandCriticalStrain(params));
-        case SolverKind::Sph:
-            if (params.sheet.outline == Outline::Sphere)
-                throw std::invalid_argument("the sph solver needs a flat rest sheet");
-            return std::make_unique<TotalLagrangianSph>(
-                lattice, params.sheet.dx, m, h, params.notches,
-                m.fractureEnergy
-                    ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, params.sheet.dx)
-                    : std::numeric_limits<double>::infinity());
-        case SolverKind::Peridynamic:
-            break;
-    }
-    return nullptr;
-}
-
 void Membrane::useSolver(std::unique_ptr<Solver> solver) {
     solver_ = std::move(solver);
     solver_->bind(bonds_, damageState_);
+    workspace_ = solver_->makeWorkspace();
     const std::vector<double> k = solver_->stiffnessRowSums(particleCount());
     double worstRatio = 0.0;
     for (int i = 0; i < particleCount(); ++i) worstRatio = std::max(worstRatio, k[i] / mass_[i]);
     setStableStep(worstRatio);
 }
-
-const PeridynamicBonds& Membrane::peridynamicBonds() const {
-    const auto* bonds = dynamic_cast<const PeridynamicBonds*>(solver_.get());
-    if (!bonds) throw std::logic_error("only the peridynamic solver has bond constants");
-    return *bonds;
-}
-
-const BondLaw& Membrane::law() const { return peridynamicBonds().law(); }
-
-double Membrane::criticalStretch() const { return peridynamicBonds().criticalStretch(); }
 
 void Membrane::setUpNotches(const MembraneParams& params) {
     const MaterialParams& m = params.material;
@@ -169,9 +113,7 @@ void Membrane::perturb(double amplitude, std::uint64_t seed) {
 }
 
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
-    force.resize(x_.size());
-    solver_->setTheta(theta_);
-    solver_->forces(x_, force);
+    solver_->forces(stepState(), *solver_->makeWorkspace(), force);
 }
 
 Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
@@ -237,8 +179,7 @@ void Membrane::integrate(double dt, double tNext) {
 }
 
 void Membrane::accumulateForces() {
-    solver_->setTheta(theta_);
-    solver_->advance(x_, v_, dt_, force_);
+    solver_->advance(stepState(), *workspace_, force_);
     stiffening_ = solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
 }
@@ -354,8 +295,7 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
-    solver_->setTheta(theta_);
-    return solver_->strainEnergy(x_);
+    return solver_->strainEnergy(stepState(), *solver_->makeWorkspace());
 }
 
 double Membrane::maxSpeed() const {
@@ -374,11 +314,6 @@ Eigen::Vector3d Membrane::totalMomentum() const {
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (int i = 0; i < particleCount(); ++i) p += mass_[i] * v_[i];
     return p;
-}
-
-Eigen::Matrix3d Membrane::particleStress(int i) const {
-    solver_->setTheta(theta_);
-    return peridynamicBonds().particleStress(i, x_);
 }
 
 FrameView Membrane::view(int frame) const {

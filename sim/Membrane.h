@@ -18,6 +18,7 @@
 #include "sim/Bonds.h"
 #include "sim/DamageState.h"
 #include "sim/Diffusion.h"
+#include "sim/Fracture.h"
 #include "sim/FrameView.h"
 #include "sim/Lattice.h"
 #include "sim/Parallel.h"
@@ -38,20 +39,6 @@ public:
     double suggestedDt;
 };
 
-/// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
-/// lattice row store the fracture energy G_f (infinity without one).
-double springCriticalStrain(const MembraneParams& params);
-
-/// Critical strain of the FEM elements and the two-parameter springs, whose cracks take out a
-/// band of elements (triangles) one row high: sqrt(2 (1 - nu^2)) times the springs'.
-double bandCriticalStrain(const MembraneParams& params);
-
-class PeridynamicBonds;
-
-/// The Solver a scene's `solver` names, for the solvers that do not use the Membrane's bonds
-/// (the peridynamic one does; the Membrane builds it).
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
-
 class Membrane {
 public:
     explicit Membrane(const MembraneParams& params);
@@ -59,12 +46,11 @@ public:
     int particleCount() const { return int(x0_.size()); }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }
-    // The peridynamic bonds' constants; these throw std::logic_error for another solver.
-    double micromodulus() const { return law().c; }
-    const BondLaw& law() const;
-    /// eta_c at theta = 0; +infinity when the material has no fracture energy.
-    double criticalStretch() const;
+    /// The scene's solver (its own constants, e.g. PeridynamicBonds::criticalStretch(), are
+    /// reached by a cast).
     const Solver& solver() const { return *solver_; }
+    /// This step's state as the solver sees it.
+    StepState stepState() const { return {x_, v_, theta_, dt_}; }
     bool hasDiffusion() const { return diffusion_.has_value(); }
     const Diffusion* diffusion() const { return diffusion_ ? &*diffusion_ : nullptr; }
     std::size_t notchedBondCount() const { return notched_; }
@@ -99,9 +85,6 @@ public:
     double maxTheta() const;  ///< 0 without diffusion
     std::size_t brokenBondCount() const;
     Eigen::Vector3d totalMomentum() const;
-    /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij (peridynamic
-    /// bonds only).
-    Eigen::Matrix3d particleStress(int i) const;
     /// The particle whose rest position (x, y) is nearest to `at` (the lowest index on a tie).
     int nearestParticle(const Eigen::Vector2d& at) const;
     /// Number of particles each boundary condition claims (a later one wins an overlap).
@@ -145,7 +128,6 @@ private:
     void setStableStep(double worstRatio);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
-    const PeridynamicBonds& peridynamicBonds() const;
     void accumulateForces();  ///< the solver's (updating its state) and pressure into force_
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
     void stepSymplecticEuler();
@@ -178,9 +160,10 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     double speedLimit_ = 0.0;
-    std::unique_ptr<Solver> solver_;  ///< the internal forces
-    double stiffening_ = 1.0;         ///< the solver's worst tangent stiffness over its rest one
-    long subSteps_ = 0;               ///< extra pieces the power law's stiffening asked for
+    std::unique_ptr<Solver> solver_;        ///< the internal forces
+    std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
+    double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
+    long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     static constexpr int kMaxPieces = 64;
 
     // Structure of arrays: one contiguous array per attribute.

@@ -2,8 +2,14 @@
 // The internal forces of one membrane discretisation. Membrane owns what every solver shares:
 // the particles and their lumped masses, the rest lattice and its triangles, boundary
 // conditions, gravity, damping, the follower pressure, the integrators with their stable step,
-// the blow-up guard, diffusion, the DamageState and the FrameView. A Solver only turns
-// positions into forces, and breaks through the DamageState's operations.
+// the blow-up guard, diffusion, the DamageState and the FrameView. A Solver only turns a step's
+// state into forces, and breaks through the DamageState's operations.
+//
+// The contract: everything a step depends on arrives in the StepState; forces() and
+// strainEnergy() are const and write only their Workspace (the solver's scratch, made by
+// makeWorkspace()) and the forces; advance() alone moves the solver's history on (yield,
+// fracture through the DamageState). Solvers are listed, with what they support, in
+// sim/SolverRegistry.h.
 //
 // Implemented by the peridynamic bonds of the membrane paper (PeridynamicBonds) and by the
 // continuum, spring and SPH models of the other papers.
@@ -20,13 +26,35 @@
 
 namespace rend::sim {
 
+struct SolverSetUp;  // sim/SolverRegistry.h: what a solver's factory builds it from
+
+/// One step's state, passed explicitly.
+struct StepState {
+    std::span<const Eigen::Vector3d> x;  ///< positions
+    std::span<const Eigen::Vector3d> v;  ///< velocities; empty where only forces are asked
+    std::span<const double> theta;       ///< the diffusing quantity; empty without diffusion
+    double dt = 0.0;                     ///< the step about to be taken [s]
+};
+
+/// A solver's scratch for one force evaluation (per-element or per-spring intermediates). Each
+/// solver derives its own and makes it with Solver::makeWorkspace().
+class Workspace {
+public:
+    virtual ~Workspace() = default;
+};
+
 class Solver {
 public:
     virtual ~Solver() = default;
 
-    /// Internal force on every particle at positions x, overwriting `force` (sized by the
-    /// caller). The sum over particles is zero: forces are internal.
-    virtual void forces(const std::vector<Eigen::Vector3d>& x,
+    /// The scratch forces(), strainEnergy() and advance() need; a plain Workspace by default.
+    virtual std::unique_ptr<Workspace> makeWorkspace() const {
+        return std::make_unique<Workspace>();
+    }
+
+    /// Internal force on every particle at s.x, overwriting `force` (resized to the particles).
+    /// The sum over particles is zero: forces are internal. Changes no state.
+    virtual void forces(const StepState& s, Workspace& work,
                         std::vector<Eigen::Vector3d>& force) const = 0;
 
     /// Per particle, half the absolute row sum of the rest stiffness matrix [N/m] (for springs,
@@ -34,22 +62,19 @@ public:
     /// for dt <= sqrt(2 m_i / k_i), the same bound as the peridynamic bonds'.
     virtual std::vector<double> stiffnessRowSums(int particleCount) const = 0;
 
-    /// Stored elastic energy at positions x [J].
-    virtual double strainEnergy(const std::vector<Eigen::Vector3d>& x) const = 0;
+    /// Stored elastic energy at s.x [J].
+    virtual double strainEnergy(const StepState& s, Workspace& work) const = 0;
 
-    /// Breaks, for good, whatever is past its critical strain at x, through the DamageState's
-    /// operations (sim/DamageState.h). Nothing breaks by default.
-    virtual void fracture(const std::vector<Eigen::Vector3d>& x) {}
+    /// Breaks, for good, whatever is past its critical strain at s.x (through the
+    /// DamageState's operations), and yields whatever yields. Nothing by default.
+    virtual void fracture(const StepState& s, Workspace& work) {}
 
-    /// One step's forces at x that also move the solver's history on: whatever is past its
-    /// critical strain breaks (through the DamageState), whatever yields yields. `v` and `dt`
-    /// let a law that stiffens (the power law in compression) look ahead for stiffening(). By
-    /// default fracture() then forces().
-    virtual void advance(const std::vector<Eigen::Vector3d>& x,
-                         const std::vector<Eigen::Vector3d>& v, double dt,
-                         std::vector<Eigen::Vector3d>& force) {
-        fracture(x);
-        forces(x, force);
+    /// One step's forces at s.x that also move the solver's history on, as fracture() then
+    /// forces(). A law that stiffens (the power law in compression) looks ahead by s.v and
+    /// s.dt for stiffening().
+    virtual void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) {
+        fracture(s, work);
+        forces(s, work, force);
     }
 
     /// The worst tangent stiffness over its rest value (>= 1) seen by the last advance(): the
@@ -74,9 +99,22 @@ public:
     /// the bonds {i, j} in `edges` broken (and their edges).
     virtual void cut(const std::vector<std::array<int, 2>>& edges) {}
 
-    /// The diffusing quantity per particle (empty without diffusion), for the solvers that
-    /// couple to it; Membrane sets it before every forces() and fracture().
-    void setTheta(std::span<const double> theta) { theta_ = theta; }
+    // Conveniences for tests and tools: one call at x (theta none) with a fresh workspace.
+    std::vector<Eigen::Vector3d> forcesAt(std::span<const Eigen::Vector3d> x) const {
+        std::vector<Eigen::Vector3d> force;
+        forces({x}, *makeWorkspace(), force);
+        return force;
+    }
+    double energyAt(std::span<const Eigen::Vector3d> x) const {
+        return strainEnergy({x}, *makeWorkspace());
+    }
+    void fractureAt(std::span<const Eigen::Vector3d> x) { fracture({x}, *makeWorkspace()); }
+    std::vector<Eigen::Vector3d> advanceAt(std::span<const Eigen::Vector3d> x,
+                                           std::span<const Eigen::Vector3d> v, double dt) {
+        std::vector<Eigen::Vector3d> force;
+        advance({x, v, {}, dt}, *makeWorkspace(), force);
+        return force;
+    }
 
 protected:
     /// What the solver derives from the bound bonds and damage maps.
@@ -93,7 +131,6 @@ protected:
         own_ = std::move(own);
     }
 
-    std::span<const double> theta_;
     const BondFamilies* sharedBonds_ = nullptr;
     DamageState* damage_ = nullptr;
 

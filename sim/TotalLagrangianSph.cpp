@@ -7,6 +7,7 @@
 
 #include "sim/Fracture.h"
 #include "sim/Parallel.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 namespace {
@@ -36,20 +37,17 @@ double sphCriticalStrain(double fractureEnergy, double youngsModulus, double dx)
     return std::sqrt(1.0 + 2.0 * green) - 1.0;
 }
 
-TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
-                                       const MaterialParams& material, double thickness,
-                                       std::span<const Notch> notches, double criticalStrain)
+TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx, const Material& material,
+                                       double thickness, std::span<const Notch> notches,
+                                       double criticalStrain)
     : rest_(lattice.positions),
       support_(kSupport * dx),
-      expansion_(material.expansion),
-      stiffnessLoss_(material.stiffnessLoss),
-      strengthLoss_(material.strengthLoss),
+      material_(material),
+      expansion_(material.expansion()),
       thickness_(thickness),
       criticalStrain_(criticalStrain) {
-    const double nu = material.poissonRatio;
-    if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("sph needs -1 < poisson < 0.5");
-    lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
-    mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
+    lambda_ = material.lambda();
+    mu_ = material.mu();
     const int n = int(rest_.size());
     pairs_ = buildBondFamilies(rest_, support_);
     pairAlive_.assign(pairs_.directedCount(), 1);
@@ -64,10 +62,19 @@ TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
     for (int i = 0; i < n; ++i)
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             mirror_[k] = findBond(pairs_, neighbours_[k], i);
-    stress_.resize(n);
     restMetric_.assign(n, -1);
     breaking_.assign(neighbours_.size(), 0);
     bindOwn({}, n, lattice.triangles);
+}
+
+std::unique_ptr<Solver> TotalLagrangianSph::make(const SolverSetUp& s) {
+    if (s.params.sheet.outline == Outline::Sphere)
+        throw std::invalid_argument("the sph solver needs a flat rest sheet");
+    const MaterialParams& m = s.params.material;
+    return std::make_unique<TotalLagrangianSph>(
+        s.lattice, s.params.sheet.dx, s.material, s.params.sheet.thickness, s.params.notches,
+        m.fractureEnergy ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, s.params.sheet.dx)
+                         : std::numeric_limits<double>::infinity());
 }
 
 void TotalLagrangianSph::onBind() {
@@ -84,10 +91,18 @@ bool TotalLagrangianSph::pairAlive(int i, int j) const {
     return k >= 0 && pairAlive_[k];
 }
 
-void TotalLagrangianSph::fracture(const std::vector<Eigen::Vector3d>& x) {
+std::unique_ptr<Workspace> TotalLagrangianSph::makeWorkspace() const {
+    return std::make_unique<SphWorkspace>();
+}
+
+void TotalLagrangianSph::fracture(const StepState& s, Workspace& work) {
     if (!std::isfinite(criticalStrain_)) return;
+    const auto& x = s.x;
+    const auto& theta = s.theta;
     const int n = int(x.size());
-    deformations(x);
+    std::vector<Eigen::Matrix<double, 3, 2>>& deformation =
+        static_cast<SphWorkspace&>(work).deformation;
+    deformations(s, deformation);
     // The pair's stretch seen through the mean of its ends' mechanical F, not its own length:
     // F filters the particle-scale (zero-energy) noise that the pair lengths carry, twice the
     // continuum's strain next to the grips (see the top). Both copies of a pair see the same
@@ -95,17 +110,16 @@ void TotalLagrangianSph::fracture(const std::vector<Eigen::Vector3d>& x) {
     int count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
-        const double si = 1.0 + expansion_ * thetaAt(i);
+        const double si = 1.0 + expansion_ * thetaAt(theta, i);
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             breaking_[k] = 0;
             if (!pairAlive_[k]) continue;
             const int j = neighbours_[k];
-            const double thetaBar = 0.5 * (thetaAt(i) + thetaAt(j));
+            const double thetaBar = 0.5 * (thetaAt(theta, i) + thetaAt(theta, j));
             const Eigen::Vector2d d = (rest_[j] - rest_[i]).head<2>() / pairs_.restLength[k];
-            const double sj = 1.0 + expansion_ * thetaAt(j);
-            const double eta =
-                (0.5 * (deformation_[i] / si + deformation_[j] / sj) * d).norm() - 1.0;
-            const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar);
+            const double sj = 1.0 + expansion_ * thetaAt(theta, j);
+            const double eta = (0.5 * (deformation[i] / si + deformation[j] / sj) * d).norm() - 1.0;
+            const double limit = criticalStrain_ * material_.strengthFactor(thetaBar);
             const double length = (x[j] - x[i]).norm() / pairs_.restLength[k];
             breaking_[k] = eta > limit || length > kTetherStretch;
             count += breaking_[k];
@@ -120,7 +134,7 @@ void TotalLagrangianSph::fracture(const std::vector<Eigen::Vector3d>& x) {
                 if (pairEdge_[k] >= 0) damage_->breakEdge(pairEdge_[k]);  // in index order
             }
     settle(touched);
-    for (int i : touched) deformation_[i] = deformationGradient(i, x);
+    for (int i : touched) deformation[i] = deformationGradient(i, x);
 }
 
 void TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
@@ -160,22 +174,19 @@ void TotalLagrangianSph::settle(std::vector<int>& touched) {
     }
 }
 
-void TotalLagrangianSph::advance(const std::vector<Eigen::Vector3d>& x,
-                                 const std::vector<Eigen::Vector3d>&, double,
+void TotalLagrangianSph::advance(const StepState& s, Workspace& work,
                                  std::vector<Eigen::Vector3d>& force) {
-    if (!std::isfinite(criticalStrain_)) {
-        forces(x, force);
-        return;
-    }
-    fracture(x);  // leaves deformation_ at x
-    forcesFrom(force);
+    if (!std::isfinite(criticalStrain_)) return forces(s, work, force);
+    fracture(s, work);  // leaves the deformation gradients at s.x in the workspace
+    forcesFrom(s, static_cast<SphWorkspace&>(work), force);
 }
 
-void TotalLagrangianSph::deformations(const std::vector<Eigen::Vector3d>& x) const {
-    const int n = int(x.size());
-    deformation_.resize(n);
+void TotalLagrangianSph::deformations(const StepState& s,
+                                      std::vector<Eigen::Matrix<double, 3, 2>>& deformation) const {
+    const int n = int(s.x.size());
+    deformation.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) deformation_[i] = deformationGradient(i, x);
+    for (int i = 0; i < n; ++i) deformation[i] = deformationGradient(i, s.x);
 }
 
 void TotalLagrangianSph::correctGradients(int i) {
@@ -196,7 +207,7 @@ void TotalLagrangianSph::correctGradients(int i) {
 }
 
 Eigen::Matrix<double, 3, 2> TotalLagrangianSph::deformationGradient(
-    int i, const std::vector<Eigen::Vector3d>& x) const {
+    int i, std::span<const Eigen::Vector3d> x) const {
     Eigen::Matrix<double, 3, 2> F = Eigen::Matrix<double, 3, 2>::Zero();
     for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
         F += (x[neighbours_[k]] - x[i]) * gradient_[k].transpose();
@@ -214,20 +225,26 @@ Eigen::Matrix<double, 3, 2> TotalLagrangianSph::firstPiola(
     return F * (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
 }
 
-void TotalLagrangianSph::forces(const std::vector<Eigen::Vector3d>& x,
+void TotalLagrangianSph::forces(const StepState& s, Workspace& work,
                                 std::vector<Eigen::Vector3d>& force) const {
-    deformations(x);
-    forcesFrom(force);
+    SphWorkspace& sph = static_cast<SphWorkspace&>(work);
+    deformations(s, sph.deformation);
+    forcesFrom(s, sph, force);
 }
 
-void TotalLagrangianSph::forcesFrom(std::vector<Eigen::Vector3d>& force) const {
-    const int n = int(deformation_.size());
+void TotalLagrangianSph::forcesFrom(const StepState& s, SphWorkspace& work,
+                                    std::vector<Eigen::Vector3d>& force) const {
+    const std::vector<Eigen::Matrix<double, 3, 2>>& deformation = work.deformation;
+    std::vector<Eigen::Matrix<double, 3, 2>>& stress = work.stress;
+    const int n = int(deformation.size());
+    stress.resize(n);
+    force.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
-        const double stretch = 1.0 + expansion_ * thetaAt(i);
-        stress_[i] = volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) /
-                     stretch * firstPiola(i, deformation_[i] / stretch);
+        const double stretch = 1.0 + expansion_ * thetaAt(s.theta, i);
+        stress[i] = volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) /
+                    stretch * firstPiola(i, deformation[i] / stretch);
     }
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
@@ -235,9 +252,9 @@ void TotalLagrangianSph::forcesFrom(std::vector<Eigen::Vector3d>& force) const {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             own += gradient_[k];
-            sum -= stress_[neighbours_[k]] * gradient_[mirror_[k]];  // - V_j h P_j g_ji
+            sum -= stress[neighbours_[k]] * gradient_[mirror_[k]];  // - V_j h P_j g_ji
         }
-        force[i] = sum + stress_[i] * own;
+        force[i] = sum + stress[i] * own;
     }
 }
 
@@ -262,13 +279,14 @@ std::vector<double> TotalLagrangianSph::stiffnessRowSums(int particleCount) cons
     return sums;
 }
 
-double TotalLagrangianSph::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+double TotalLagrangianSph::strainEnergy(const StepState& s, Workspace&) const {
+    const auto& x = s.x;
     double sum = 0.0;
     for (int i = 0; i < int(x.size()); ++i) {
         const Eigen::Matrix<double, 3, 2> F =
-            deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(i));
+            deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(s.theta, i));
         const Eigen::Matrix2d E = greenStrain(i, F);
-        sum += volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) *
+        sum += volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }
     return sum;

@@ -13,7 +13,7 @@ namespace rend::test {
 /// A 0.2 m FEM sheet that breaks (G_f = 5) under `pressure`.
 inline sim::MembraneParams erodingSheet(double pressure) {
     sim::MembraneParams p;
-    p.solver = sim::SolverKind::FemCst;
+    p.solver = "fem_cst";
     p.sheet.size = {0.2, 0.2};
     p.sheet.dx = 0.02;
     p.material.youngsModulus = 2e4;

@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "tests/sim/Peridynamic.h"
+
 namespace rend::checks {
 
 using namespace rend::sim;
@@ -24,9 +26,9 @@ ReleaseRecord runCrackRelease(const NotchedStrip& s, double windowStart, double 
     const auto& rest = m.restPositions();
     const double halfReach = 0.5 * m.horizon() + 1e-9;  // see runCrack
     ReleaseRecord r;
-    if (s.solver == SolverKind::Peridynamic)
-        r.critical = m.criticalStretch();
-    else if (s.solver != SolverKind::FemCst && s.solver != SolverKind::Sph)
+    if (s.solver == "peridynamic")
+        r.critical = rend::test::criticalStretch(m);
+    else if (s.solver != "fem_cst" && s.solver != "sph")
         r.critical = springCriticalStrain(p);  // a spring is the bond along it
     auto midpoint = [&](int i, int b) { return 0.5 * (rest[i] + rest[bonds.partners[b]]); };
     for (int i = 0; i < m.particleCount(); ++i)

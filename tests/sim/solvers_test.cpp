@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
 #include <numbers>
 #include <utility>
 
@@ -16,6 +19,7 @@
 #include "sim/Membrane.h"
 #include "sim/PeridynamicBonds.h"
 #include "sim/Random.h"
+#include "sim/SolverRegistry.h"
 #include "tests/sim/ErodedElement.h"
 #include "tests/sim/Peridynamic.h"
 #include "tests/sim/ThreadCheck.h"
@@ -512,4 +516,37 @@ TEST(Damage, EverySolverBreaksOnlyThroughTheDamageState) {
         support::expectConsistentDamage(m);
         EXPECT_GT(m.brokenBondCount(), notched) << "the crack grew";
     }
+}
+
+TEST(SolverRegistry, NamesEachSolverOnceAndEveryFactoryBuildsARunningMembrane) {
+    std::set<std::string_view> names;
+    for (const SolverEntry& entry : solverRegistry()) {
+        EXPECT_TRUE(names.insert(entry.name).second) << entry.name << " twice";
+        EXPECT_EQ(findSolver(entry.name), &entry);
+        MembraneParams p = sheet(std::string(entry.name), 0.3, 0.12, 0.12);
+        Membrane m(p);
+        EXPECT_NO_THROW(m.step()) << entry.name;
+    }
+    EXPECT_EQ(solverRegistry().front().name, MembraneParams{}.solver) << "the default first";
+    EXPECT_EQ(findSolver("mpm"), nullptr);
+    EXPECT_THROW(solverEntry("mpm"), std::invalid_argument);
+}
+
+TEST(SolverRegistry, SaysWhatASolverDoesNotTake) {
+    MembraneParams p = sheet("sph", 0.3);
+    p.material.law = BondLawKind::PowerLaw;
+    p.material.surfaceCorrection = true;
+    EXPECT_EQ(unsupportedFeatures(solverEntry("sph"), p),
+              "a bond law other than linear and surface_correction");
+    EXPECT_EQ(unsupportedFeatures(solverEntry("peridynamic"), p), "");
+}
+
+TEST(SolverRegistry, TheReadmeSolverTableIsTheRegistrys) {
+    std::ifstream in(std::string(REND_SOURCE_DIR) + "/README.md");
+    std::stringstream readme;
+    readme << in.rdbuf();
+    const std::string table = solverTableMarkdown();
+    EXPECT_NE(readme.str().find(table), std::string::npos)
+        << "README \"Solvers\" must hold the registry's table:\n"
+        << table;
 }

@@ -337,11 +337,11 @@ bool FemCst::pastCriticalStrain(int t, std::span<const Eigen::Vector3d> x,
     return centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1);
 }
 
-void FemCst::erodeFlagged() {
+void FemCst::erodeFlagged(bool breakSides) {
     for (int t = 0; t < int(elements_.size()); ++t)
         if (eroding_[t]) {
             eroding_[t] = 0;
-            erode(t, true);
+            erode(t, breakSides);
         }
 }
 
@@ -358,7 +358,7 @@ void FemCst::fracture(const StepState& s, Workspace&) {
             yieldElement(t, stretchesOf(deformationGradient(elements_[t], x) / stretch));
         if (breakable && pastCriticalStrain(t, x, s.theta)) eroding_[t] = 1;
     }
-    erodeFlagged();
+    erodeFlagged(true);
 }
 
 void FemCst::cut(const std::vector<std::array<int, 2>>&) {
@@ -368,11 +368,7 @@ void FemCst::cut(const std::vector<std::array<int, 2>>&) {
     for (int t = 0; t < int(elements_.size()); ++t)
         for (const int e : damage_->triangleEdges(elements_[t].triangle))
             if (!damage_->edgeIntact(e)) eroding_[t] = 1;
-    for (int t = 0; t < int(elements_.size()); ++t)
-        if (eroding_[t]) {
-            eroding_[t] = 0;
-            erode(t, false);
-        }
+    erodeFlagged(false);
 }
 
 double FemCst::strainEnergy(const StepState& s, Workspace&) const {

@@ -134,8 +134,8 @@ private:
     bool pastCriticalStrain(int t, std::span<const Eigen::Vector3d> x,
                             std::span<const double> theta) const;
     /// Removes the flagged elements in index order (so the sides broken do not depend on
-    /// the thread count) and clears the flags.
-    void erodeFlagged();
+    /// the thread count) and clears the flags; see erode() for `breakSides`.
+    void erodeFlagged(bool breakSides);
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each

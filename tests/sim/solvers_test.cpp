@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <set>
 #include <sstream>
-#include <numbers>
 #include <utility>
 
 #include "sim/FemCst.h"

@@ -157,7 +157,7 @@ std::string stateHash(const sim::Membrane& m) {
     mix(m.positions().data(), m.positions().size() * sizeof(Eigen::Vector3d));
     mix(m.velocities().data(), m.velocities().size() * sizeof(Eigen::Vector3d));
     mix(m.theta().data(), m.theta().size() * sizeof(double));
-    mix(m.bonds().alive.data(), m.bonds().alive.size());
+    mix(m.damageState().bondAlive().data(), m.damageState().bondAlive().size());
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
     return hex;

@@ -14,6 +14,7 @@
 #include "app/SceneError.h"
 #include "app/SceneNames.h"
 #include "app/SceneReader.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend {
 namespace {
@@ -584,34 +585,16 @@ void readOutput(const TableReader& root, Scene& scene) {
     }
 }
 
-// `solver = "..."` at the top level. Every solver takes notches and couples to theta; all but the
-// SPH break by a critical strain from fracture_energy; only Van Gelder's springs take the bond
-// laws, and the SPH needs a flat sheet: a scene asking for what its solver lacks is refused,
+// `solver = "..."` at the top level: a name from the solver registry (sim/SolverRegistry.h),
+// which also says what each solver takes. A scene asking for what its solver lacks is refused,
 // not silently run without.
 void readSolver(const TableReader& root, sim::MembraneParams& p) {
     const scene::Param& kSolver = root.param("solver");
-    const auto& kSolvers = names::kSolvers;
-    p.solver = sim::SolverKind(root.choice(kSolver.key).value_or(std::size_t(p.solver)));
-    if (p.solver == sim::SolverKind::Peridynamic) return;
-    const sim::MaterialParams& m = p.material;
-    std::vector<std::string> wanted;
-    // Every solver takes notches, fracture and the coupling to theta, and all but the SPH the
-    // three bond laws.
-    const bool sph = p.solver == sim::SolverKind::Sph;
-    if (m.law != sim::BondLawKind::Linear && sph) wanted.push_back("a bond law other than linear");
-    if (m.criticalStretch == sim::CriticalStretchMode::Paper)
-        wanted.push_back("critical_stretch = \"paper\"");
-
-    if (sph && p.sheet.outline == sim::Outline::Sphere) wanted.push_back("shape = \"sphere\"");
-
-    if (m.surfaceCorrection) wanted.push_back("surface_correction");
-    std::string needs;
-    for (std::size_t k = 0; k < wanted.size(); ++k)
-        needs += (k == 0 ? "" : k + 1 == wanted.size() ? " and " : ", ") + wanted[k];
+    if (const auto k = root.choice(kSolver.key)) p.solver = std::string(kSolver.names[*k]);
+    const std::string needs = sim::unsupportedFeatures(sim::solverEntry(p.solver), p);
     if (needs.empty()) return;
-    const std::string solver(kSolvers[std::size_t(p.solver)]);
-    root.fail(kSolver.key, "a solver that takes " + needs, "\"" + solver + "\"",
-              "The " + solver + " solver does not take " + needs +
+    root.fail(kSolver.key, "a solver that takes " + needs, "\"" + p.solver + "\"",
+              "The " + p.solver + " solver does not take " + needs +
                   "; remove it or use solver = \"peridynamic\" (README \"Solvers\" lists what "
                   "each takes).");
 }

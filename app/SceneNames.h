@@ -17,9 +17,6 @@ inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper"}
 inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 inline constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
 inline constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};
-/// sim::SolverKind; the solver registry takes these over.
-inline constexpr std::string_view kSolvers[] = {"peridynamic", "fem_cst", "mass_spring_vg",
-                                                "mass_spring_tp", "sph"};
 inline constexpr std::string_view kRenderers[] = {"osmesa", "none", "embree"};
 inline constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
 inline constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};

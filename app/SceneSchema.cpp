@@ -10,6 +10,7 @@
 
 #include "app/SceneNames.h"
 #include "app/SceneReader.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::scene {
 namespace {
@@ -25,14 +26,15 @@ constexpr Range kTheta = closed(-1e6, 1e6);
 constexpr Range kRate = closed(-1e9, 1e9);
 constexpr Range kSeed = closed(0.0, 9e18);  ///< below 2^63
 
-constexpr Param kRoot[] = {
+// Not constexpr: the solver names are the registry's (sim/SolverRegistry.h).
+const Param kRoot[] = {
     {"solver",
      T::Choice,
      {},
      "\"peridynamic\"",
      "the discretisation of the membrane (see Solvers)",
      "\"fem_cst\"",
-     names::kSolvers},
+     sim::solverNames()},
     {"sheet", T::Table, {}, "", "the membrane's outline and lattice", "", {}, "sheet"},
     {"material", T::Table, {}, "", "the membrane's material", "", {}, "material"},
     {"boundary", T::Tables, {}, "", "a boundary condition", "", {}, "boundary"},
@@ -375,7 +377,7 @@ constexpr Param kOutput[] = {
      names::kExportFormats},
 };
 
-constexpr Section kSchema[] = {
+const Section kSchema[] = {
     {"", "the top-level table", kRoot},
     {"sheet", "[sheet]", kSheet},
     {"material", "[material]", kMaterial},

@@ -10,12 +10,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include "app/Pipeline.h"
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneNames.h"
 #include "render/Versions.h"
+#include "sim/SolverRegistry.h"
 
 namespace {
 
@@ -125,6 +127,15 @@ CLI::Validator nonEmpty(const std::string& expected, const std::string& example)
         "");
 }
 
+// The solvers a scene can name, from the registry, for `rend --help` and `rend run --help`.
+std::string solverHelp() {
+    std::string out = "Solvers (solver = \"NAME\" in a scene, or --set solver=NAME):\n";
+    for (const rend::sim::SolverEntry& e : rend::sim::solverRegistry())
+        out += "  " + std::string(e.name) + std::string(16 - e.name.size(), ' ') +
+               std::string(e.model) + "\n";
+    return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -132,6 +143,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(0, 1);
     bool version = false;
     app.add_flag("--version", version, "Print the versions of rend and every library in use");
+    app.footer(solverHelp());
 
     RunArgs run;
     CLI::App* runCmd = app.add_subcommand("run", "Simulate a scene and write its outputs");
@@ -153,6 +165,7 @@ int main(int argc, char** argv) {
     runCmd->add_option("--threads", run.threads, "OpenMP threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     runCmd->add_option("--set", run.sets, "Override a scene value: key.path=value (repeatable)");
+    runCmd->footer(solverHelp());
 
     std::string checkScene;
     std::vector<std::string> checkSets;

@@ -48,7 +48,8 @@ CrackState measure(const rend::sim::Membrane& m, int axis) {
     for (int i = 0; i < m.particleCount(); ++i)
         for (int k = b.offsets[i]; k < b.offsets[i + 1]; ++k) {
             const int j = b.partners[k];
-            if (j < i || b.alive[k]) continue;  // each bond once, from its lower end
+            if (j < i || m.damageState().bondAlive()[k])
+                continue;  // each bond once, from its lower end
             const double mid = 0.5 * (x0[i][axis] + x0[j][axis]);
             s.lo = std::min(s.lo, mid);
             s.hi = std::max(s.hi, mid);

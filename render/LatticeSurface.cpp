@@ -15,12 +15,6 @@ namespace {
 
 constexpr std::uint32_t kUnassigned = std::numeric_limits<std::uint32_t>::max();
 
-bool bondIntact(const sim::FrameView& frame, int bond) {
-    // Edges without a bond (e.g. square-lattice diagonals) carry no damage information, so
-    // they never drop their triangle.
-    return bond < 0 || frame.bondAlive[bond] != 0;
-}
-
 std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& positions,
                                            const std::vector<std::array<std::uint32_t, 3>>& tris) {
     std::vector<Eigen::Vector3f> normals(positions.size(), Eigen::Vector3f::Zero());
@@ -160,19 +154,13 @@ void extrude(Mesh& mesh, double thickness) {
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
       edgeNeighbours_(edgeNeighbours(triangles_)) {
-    edgeBonds_ = triangleEdgeBonds(rest, triangles_);
     // Ascending triangle order fixes which fan keeps the particle's own vertex.
     incidentTriangles(triangles_, vertexCount(rest, triangles_), incidentOffsets_, incident_);
 }
 
 std::vector<std::uint8_t> LatticeSurface::keptFlags(const sim::FrameView& frame) const {
     std::vector<std::uint8_t> kept(triangles_.size(), 0);
-    for (std::size_t t = 0; t < triangles_.size(); ++t) {
-        bool intact = true;
-        for (int e = 0; e < 3; ++e) intact = intact && bondIntact(frame, edgeBonds_[t][e]);
-        if (!frame.triangleAlive.empty()) intact = intact && frame.triangleAlive[t];
-        kept[t] = intact ? 1 : 0;
-    }
+    for (std::size_t t = 0; t < triangles_.size(); ++t) kept[t] = frame.triangleKept(t) ? 1 : 0;
     return kept;
 }
 

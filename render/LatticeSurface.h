@@ -26,13 +26,12 @@ namespace rend::render {
 /// only recomputes which triangles are kept and walks each particle's fans: O(triangles).
 class LatticeSurface {
 public:
-    /// Maps every rest triangle's edges to bond indices once. An edge that is not a bond
-    /// (a square lattice with R < sqrt(2) dx has no diagonal bonds) never drops its triangle.
+    /// Builds the triangles around each particle and the edge adjacency once.
     explicit LatticeSurface(const sim::FrameView& rest);
 
-    /// Triangles whose three edge bonds are intact, with vertices duplicated along cracks
-    /// (see above), smooth (area-weighted) normals per vertex and per-vertex colours from the
-    /// settings' ColorBy.
+    /// The frame's kept triangles (FrameView::keptTriangles), with vertices duplicated along
+    /// cracks (see above), smooth (area-weighted) normals per vertex and per-vertex colours from
+    /// the settings' ColorBy.
     ///
     /// With settings.thickness > 0 the sheet becomes a solid: the mesh above, offset by
     /// +thickness/2 along the vertex normals (same vertex indices, so vertices
@@ -61,7 +60,6 @@ private:
     int cornerOf(int triangle, int particle) const;
 
     std::vector<std::array<int, 3>> triangles_;
-    std::vector<std::array<int, 3>> edgeBonds_;  ///< bond index per edge (i->j), -1 if none
     /// Triangle across edge e (corners e, e+1) of each triangle; -1 on the rest boundary.
     std::vector<std::array<int, 3>> edgeNeighbours_;
     /// Triangles incident to particle i: incident_[incidentOffsets_[i] .. [i + 1]), ascending.

@@ -2,16 +2,6 @@
 
 namespace rend::render {
 
-std::vector<std::array<int, 3>> triangleEdgeBonds(
-    const sim::FrameView& rest, const std::vector<std::array<int, 3>>& triangles) {
-    std::vector<std::array<int, 3>> bonds;
-    bonds.reserve(triangles.size());
-    for (const auto& t : triangles)
-        bonds.push_back(
-            {rest.findBond(t[0], t[1]), rest.findBond(t[1], t[2]), rest.findBond(t[2], t[0])});
-    return bonds;
-}
-
 void incidentTriangles(const std::vector<std::array<int, 3>>& triangles, std::size_t vertexCount,
                        std::vector<int>& offsets, std::vector<int>& incident) {
     offsets.assign(vertexCount + 1, 0);

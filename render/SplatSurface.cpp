@@ -67,12 +67,6 @@ double meanCircumradius(const sim::FrameView& rest) {
     return sum / double(rest.restTriangles.size());
 }
 
-bool bondIntact(const sim::FrameView& frame, int bond) {
-    // Edges without a bond (square-lattice diagonals at a short horizon) carry no damage
-    // information, so they never drop their triangle (as in LatticeSurface).
-    return bond < 0 || frame.bondAlive[bond] != 0;
-}
-
 // Any unit vector perpendicular to `axis` (unit), preferring the part of `reference` that is.
 Eigen::Vector3d perpendicularTowards(const Eigen::Vector3d& axis,
                                      const Eigen::Vector3d& reference) {
@@ -130,17 +124,12 @@ SplatSurface::SplatSurface(const sim::FrameView& rest)
         throw std::invalid_argument(
             "splat surface: the rest lattice has no bond and no triangle to size discs from");
     radius_ = std::max(kSpacingFactor * dx, kCircumradiusMargin * meanCircumradius(rest));
-    edgeBonds_ = triangleEdgeBonds(rest, triangles_);
     incidentTriangles(triangles_, rest.particleCount(), incidentOffsets_, incident_);
 }
 
 std::vector<std::uint8_t> SplatSurface::keptTriangles(const sim::FrameView& frame) const {
     std::vector<std::uint8_t> kept(triangles_.size(), 0);
-    for (std::size_t t = 0; t < triangles_.size(); ++t) {
-        const auto& bonds = edgeBonds_[t];
-        kept[t] = bondIntact(frame, bonds[0]) && bondIntact(frame, bonds[1]) &&
-                  bondIntact(frame, bonds[2]);
-    }
+    for (std::size_t t = 0; t < triangles_.size(); ++t) kept[t] = frame.triangleKept(t) ? 1 : 0;
     return kept;
 }
 

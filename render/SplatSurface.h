@@ -27,9 +27,9 @@ double restSpacing(const sim::FrameView& rest);
 /// that still has a triangle normal, else with +z; (0, 0, 1) for an isolated particle.
 class SplatSurface {
 public:
-    /// Precomputes each particle's incident triangles, each triangle's edge bonds and the disc
-    /// radius. Throws std::invalid_argument when the rest lattice has no bond and no triangle
-    /// (nothing to size discs from).
+    /// Precomputes each particle's incident triangles and the disc radius. Throws
+    /// std::invalid_argument when the rest lattice has no bond and no triangle (nothing to size
+    /// discs from).
     explicit SplatSurface(const sim::FrameView& rest);
 
     Splats build(const sim::FrameView& frame, const RenderSettings& settings) const;
@@ -37,8 +37,11 @@ public:
     /// The disc radius used for every particle [m].
     double radius() const { return radius_; }
 
-private:
+    /// Per rest triangle, 1 where the frame keeps it (FrameView::keptTriangles): the discs'
+    /// normals come from these.
     std::vector<std::uint8_t> keptTriangles(const sim::FrameView& frame) const;
+
+private:
     /// Sum of the kept incident triangles' doubled-area normals; zero when none is kept.
     Eigen::Vector3d triangleNormal(const sim::FrameView& frame,
                                    const std::vector<std::uint8_t>& kept, int particle) const;
@@ -48,7 +51,6 @@ private:
                                    int particle) const;
 
     std::vector<std::array<int, 3>> triangles_;
-    std::vector<std::array<int, 3>> edgeBonds_;  ///< bond index per edge (i->j), -1 if none
     /// Triangles incident to particle i: incident_[incidentOffsets_[i] .. [i + 1]).
     std::vector<int> incidentOffsets_;
     std::vector<int> incident_;

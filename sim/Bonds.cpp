@@ -58,7 +58,6 @@ BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double hor
     bonds.partners.resize(m);
     bonds.restLength.resize(m);
     bonds.weight.resize(m);
-    bonds.alive.assign(m, 1);
     for (int i = 0; i < n; ++i) {
         int b = bonds.offsets[i];
         for (int j : family[i]) {

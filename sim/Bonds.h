@@ -1,6 +1,7 @@
 #pragma once
 // Bond families in CSR form, each bond stored from both ends so a force loop over particle i
-// writes only to i (LAMMPS PERI style): no atomics, identical bits for any thread count.
+// writes only to i (LAMMPS PERI style): no atomics, identical bits for any thread count. Which
+// bonds are broken is the DamageState's (sim/DamageState.h), not theirs.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -11,11 +12,10 @@
 namespace rend::sim {
 
 struct BondFamilies {
-    std::vector<int> offsets;         ///< bonds of particle i: [offsets[i], offsets[i+1])
-    std::vector<int> partners;        ///< j
-    std::vector<double> restLength;   ///< |x0_j - x0_i|
-    std::vector<double> weight;       ///< W0 = 1 - |r0|/R, eq. 23
-    std::vector<std::uint8_t> alive;  ///< 1 intact, 0 broken
+    std::vector<int> offsets;        ///< bonds of particle i: [offsets[i], offsets[i+1])
+    std::vector<int> partners;       ///< j
+    std::vector<double> restLength;  ///< |x0_j - x0_i|
+    std::vector<double> weight;      ///< W0 = 1 - |r0|/R, eq. 23
 
     int particleCount() const { return int(offsets.size()) - 1; }
     std::size_t directedCount() const { return partners.size(); }

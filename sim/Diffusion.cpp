@@ -71,14 +71,15 @@ std::vector<double> Diffusion::initialTheta() const {
     return theta;
 }
 
-void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt) {
+void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
+                     std::span<const std::uint8_t> alive, double t, double dt) {
     const int n = int(theta.size());
     scratch_.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         double flux = 0.0;
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
-            if (bonds.alive[b]) flux += rate_[b] * (theta[bonds.partners[b]] - theta[i]);
+            if (alive[b]) flux += rate_[b] * (theta[bonds.partners[b]] - theta[i]);
         scratch_[i] = theta[i] + dt * flux;
     }
     theta.swap(scratch_);
@@ -88,12 +89,12 @@ void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds, doub
     for (const auto& [i, value] : held_) theta[i] = value;
 }
 
-void Diffusion::advance(std::vector<double>& theta, const BondFamilies& bonds, double t,
-                        double dt) {
+void Diffusion::advance(std::vector<double>& theta, const BondFamilies& bonds,
+                        std::span<const std::uint8_t> alive, double t, double dt) {
     // 0.9 of the Gershgorin bound keeps a margin for rounding.
     const int substeps = std::max(1, int(std::ceil(dt / (0.9 * stableDt_))));
     const double h = dt / substeps;
-    for (int k = 0; k < substeps; ++k) step(theta, bonds, t + k * h, h);
+    for (int k = 0; k < substeps; ++k) step(theta, bonds, alive, t + k * h, h);
 }
 
 }  // namespace rend::sim

@@ -38,7 +38,8 @@ public:
     std::vector<double> initialTheta() const;
 
     /// Advances theta from t to t + dt, sub-stepping as the stability bound requires.
-    void advance(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt);
+    void advance(std::vector<double>& theta, const BondFamilies& bonds,
+                 std::span<const std::uint8_t> alive, double t, double dt);
 
     std::size_t spotCount() const { return spots_.size(); }
 
@@ -49,7 +50,8 @@ private:
     };
     void addSpot(const DiffusionSpot& spot, std::span<const Eigen::Vector3d> rest);
     void expandScatter(const SpotScatter& scatter, std::span<const Eigen::Vector3d> rest);
-    void step(std::vector<double>& theta, const BondFamilies& bonds, double t, double dt);
+    void step(std::vector<double>& theta, const BondFamilies& bonds,
+              std::span<const std::uint8_t> alive, double t, double dt);
 
     double K_ = 0.0;
     double stableDt_ = 0.0;

@@ -6,7 +6,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "sim/Fracture.h"
 #include "sim/Parallel.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 
@@ -25,7 +27,7 @@ void triangleIncidence(const std::vector<std::array<int, 3>>& triangles, int par
 namespace {
 
 /// A guard, not physics: a principal stretch below this (an element squashed to 5%) is held
-/// there, as Membrane's power-law look-ahead holds the strain at -0.95.
+/// there, as the power-law look-ahead holds the strain (sim/Material.h, clampCompression).
 constexpr double kMinStretch = 0.05;
 
 /// Eigen-decomposition of a symmetric 2x2 matrix in closed form: values largest first, unit
@@ -100,18 +102,15 @@ PowerShape powerShape(const BondLaw& law, double e) {
 
 }  // namespace
 
-FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double thickness,
+FemCst::FemCst(const Lattice& lattice, const Material& material, double thickness,
                double criticalStrain)
-    : thickness_(thickness),
+    : material_(material),
+      lambda_(material.lambda()),
+      mu_(material.mu()),
+      thickness_(thickness),
       criticalStrain_(criticalStrain),
-      expansion_(material.expansion),
-      stiffnessLoss_(material.stiffnessLoss),
-      strengthLoss_(material.strengthLoss),
-      law_(BondLaw::fromMaterial(material, 1.0)) {
-    const double nu = material.poissonRatio;
-    if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("fem_cst needs -1 < poisson < 0.5");
-    lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
-    mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
+      expansion_(material.expansion()),
+      law_(material.law(1.0)) {
     const auto& p = lattice.positions;
     for (int index = 0; index < int(lattice.triangles.size()); ++index) {
         const auto& t = lattice.triangles[index];
@@ -127,17 +126,22 @@ FemCst::FemCst(const Lattice& lattice, const MaterialParams& material, double th
         elements_.push_back({t, Dm.inverse(), area, index, {-1, -1, -1}});
     }
     findNeighbours();
-    alive_.assign(elements_.size(), 1);
-    triangleAlive_.assign(lattice.triangles.size(), 1);
+    elementOf_.assign(lattice.triangles.size(), -1);
+    for (int t = 0; t < int(elements_.size()); ++t) elementOf_[elements_[t].triangle] = t;
     std::vector<std::array<int, 3>> kept;
     for (const Element& e : elements_) kept.push_back(e.v);
     triangleIncidence(kept, int(p.size()), cornerOffsets_, corners_);
-    cornerForce_.resize(3 * elements_.size());
     eroding_.assign(elements_.size(), 0);
     if (law_.kind == BondLawKind::Elastoplastic) {
         plasticStrain_.assign(elements_.size(), Eigen::Matrix2d::Zero());
         maxStrain_.assign(elements_.size(), 0.0);
     }
+    bindOwn({}, int(p.size()), lattice.triangles);
+}
+
+std::unique_ptr<Solver> FemCst::make(const SolverSetUp& s) {
+    return std::make_unique<FemCst>(s.lattice, s.material, s.params.sheet.thickness,
+                                    bandCriticalStrain(s.params));
 }
 
 void FemCst::findNeighbours() {
@@ -152,85 +156,76 @@ void FemCst::findNeighbours() {
         }
 }
 
-Eigen::Matrix<double, 3, 2> FemCst::deformationGradient(
-    const Element& e, const std::vector<Eigen::Vector3d>& x) const {
+Eigen::Matrix<double, 3, 2> FemCst::deformationGradient(const Element& e,
+                                                        std::span<const Eigen::Vector3d> x) const {
     Eigen::Matrix<double, 3, 2> Ds;
     Ds.col(0) = x[e.v[1]] - x[e.v[0]];
     Ds.col(1) = x[e.v[2]] - x[e.v[0]];
     return Ds * e.restInverse;
 }
 
-Eigen::Matrix2d FemCst::greenStrain(int t, const std::vector<Eigen::Vector3d>& x) const {
+Eigen::Matrix2d FemCst::greenStrain(int t, std::span<const Eigen::Vector3d> x) const {
     const Eigen::Matrix<double, 3, 2> F = deformationGradient(elements_[t], x);
     return 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
 }
 
-void FemCst::forces(const std::vector<Eigen::Vector3d>& x,
-                    std::vector<Eigen::Vector3d>& force) const {
-    // With kAdvance = false the pass writes nothing but the forces (and its scratch corners).
-    const_cast<FemCst*>(this)->elementPass<false>(x, force, nullptr, 0.0);
+std::unique_ptr<Workspace> FemCst::makeWorkspace() const {
+    auto work = std::make_unique<FemWorkspace>();
+    work->cornerForce.resize(3 * elements_.size());
+    return work;
 }
 
-template <bool kAdvance>
-double FemCst::elementPass(const std::vector<Eigen::Vector3d>& x,
-                           std::vector<Eigen::Vector3d>& force,
-                           const std::vector<Eigen::Vector3d>* v, double dt) {
+// One parallel pass over the elements into per-corner forces, then the gather: each particle
+// sums its own corners, so the loop needs no atomics and no ordering by thread.
+void FemCst::forces(const StepState& s, Workspace& work,
+                    std::vector<Eigen::Vector3d>& force) const {
+    std::vector<Eigen::Vector3d>& cornerForce = static_cast<FemWorkspace&>(work).cornerForce;
+    const std::span<const Eigen::Vector3d> x = s.x;
+    const bool ahead = !s.v.empty() && law_.kind == BondLawKind::PowerLaw;
     const int elements = int(elements_.size());
-    const bool breakable = std::isfinite(criticalStrain_);
     double lowest = 0.0;
 #pragma omp parallel for schedule(static) reduction(min \
                                                     : lowest) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {
         const Element& e = elements_[t];
-        if (!alive_[t]) {
-            cornerForce_[3 * t] = cornerForce_[3 * t + 1] = cornerForce_[3 * t + 2] =
+        if (!elementAlive(t)) {
+            cornerForce[3 * t] = cornerForce[3 * t + 1] = cornerForce[3 * t + 2] =
                 Eigen::Vector3d::Zero();
             continue;
         }
         // The thermal strain stretches the rest state isotropically by s = 1 + alpha theta:
         // Psi(F / s), whose derivative is P(F / s) / s.
-        const double theta = thetaOf(e), stretch = 1.0 + expansion_ * theta;
+        const double theta = thetaOf(e, s.theta), stretch = 1.0 + expansion_ * theta;
         const Eigen::Matrix<double, 3, 2> F = deformationGradient(e, x) / stretch;
         const bool linear = law_.kind == BondLawKind::Linear;
-        Stretches principal;  // the non-linear laws': one decomposition for yield and stress
-        if (!linear) principal = stretchesOf(F);
-        if constexpr (kAdvance) {
-            if (!maxStrain_.empty()) yieldElement(t, principal);  // eq. 20, this element's own
-            if (breakable && pastCriticalStrain(t, x)) {
-                eroding_[t] = 1;
-                cornerForce_[3 * t] = cornerForce_[3 * t + 1] = cornerForce_[3 * t + 2] =
-                    Eigen::Vector3d::Zero();
-                continue;
-            }
-        }
         Eigen::Matrix2d S;
         if (linear) {
             const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
-            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
+            S = material_.stiffnessFactor(theta) *
                 (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
         } else {
-            const bool ahead = v && law_.kind == BondLawKind::PowerLaw;
             Eigen::Matrix<double, 3, 2> rate;
-            if (ahead) rate = deformationGradient(e, *v) / stretch;
-            S = std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
-                nonlinearStress(t, F, principal, nullptr, ahead ? &rate : nullptr, dt,
-                                ahead ? &lowest : nullptr);
+            if (ahead) rate = deformationGradient(e, s.v) / stretch;
+            S = material_.stiffnessFactor(theta) * nonlinearStress(t, F, stretchesOf(F), nullptr,
+                                                                   ahead ? &rate : nullptr, s.dt,
+                                                                   ahead ? &lowest : nullptr);
         }
         const Eigen::Matrix<double, 3, 2> H =
             -e.restArea * thickness_ / stretch * F * S * e.restInverse.transpose();
-        cornerForce_[3 * t + 1] = H.col(0);
-        cornerForce_[3 * t + 2] = H.col(1);
-        cornerForce_[3 * t] = -H.col(0) - H.col(1);
+        cornerForce[3 * t + 1] = H.col(0);
+        cornerForce[3 * t + 2] = H.col(1);
+        cornerForce[3 * t] = -H.col(0) - H.col(1);
     }
     const int n = int(x.size());
+    force.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = cornerOffsets_[i]; k < cornerOffsets_[i + 1]; ++k)
-            sum += cornerForce_[corners_[k]];
+            sum += cornerForce[corners_[k]];
         force[i] = sum;
     }
-    return lowest;
+    static_cast<FemWorkspace&>(work).lowest = lowest;
 }
 
 std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
@@ -251,18 +246,19 @@ std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
     return sums;
 }
 
-double FemCst::thetaOf(const Element& e) const {
-    if (theta_.empty()) return 0.0;
-    return (theta_[e.v[0]] + theta_[e.v[1]] + theta_[e.v[2]]) / 3.0;
+double FemCst::thetaOf(const Element& e, std::span<const double> theta) {
+    if (theta.empty()) return 0.0;
+    return (theta[e.v[0]] + theta[e.v[1]] + theta[e.v[2]]) / 3.0;
 }
 
-void FemCst::erode(int t, std::vector<std::array<int, 2>>& apart) {
-    alive_[t] = 0;
-    triangleAlive_[elements_[t].triangle] = 0;
+void FemCst::erode(int t, bool breakSides) {
+    const int triangle = elements_[t].triangle;
+    damage_->removeTriangle(triangle);
+    if (!breakSides) return;
     for (int s = 0; s < 3; ++s) {  // a side comes apart once no living element holds it
         const int other = elements_[t].across[s];
-        if (other >= 0 && alive_[other]) continue;
-        apart.push_back({elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]});
+        if (other >= 0 && elementAlive(other)) continue;
+        damage_->breakEdge(damage_->triangleEdges(triangle)[s]);
     }
 }
 
@@ -326,11 +322,12 @@ void FemCst::yieldElement(int t, const Stretches& p) {
     }
 }
 
-bool FemCst::pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) const {
+bool FemCst::pastCriticalStrain(int t, std::span<const Eigen::Vector3d> x,
+                                std::span<const double> thetas) const {
     // Largest principal Green strain of the mechanical part against the critical stretch's,
     // (l^2 - 1) / 2, with l = 1 + eps_c weakened by theta.
-    const double theta = thetaOf(elements_[t]);
-    const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * theta);
+    const double theta = thetaOf(elements_[t], thetas);
+    const double limit = criticalStrain_ * material_.strengthFactor(theta);
     const double stretch = 1.0 + expansion_ * theta;
     const Eigen::Matrix2d E =
         0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
@@ -340,47 +337,46 @@ bool FemCst::pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) co
     return centre + radius > 0.5 * ((1 + limit) * (1 + limit) - 1);
 }
 
-void FemCst::erodeFlagged(std::vector<std::array<int, 2>>& apart) {
+void FemCst::erodeFlagged(bool breakSides) {
     for (int t = 0; t < int(elements_.size()); ++t)
         if (eroding_[t]) {
             eroding_[t] = 0;
-            erode(t, apart);
+            erode(t, breakSides);
         }
 }
 
-std::vector<std::array<int, 2>> FemCst::fracture(const std::vector<Eigen::Vector3d>& x) {
-    std::vector<std::array<int, 2>> apart;
+void FemCst::fracture(const StepState& s, Workspace&) {
+    const std::span<const Eigen::Vector3d> x = s.x;
     const bool breakable = std::isfinite(criticalStrain_);
-    if (maxStrain_.empty() && !breakable) return apart;
+    if (maxStrain_.empty() && !breakable) return;
     const int elements = int(elements_.size());
 #pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
     for (int t = 0; t < elements; ++t) {  // each element's own history and flag
-        if (!alive_[t]) continue;
-        const double stretch = 1.0 + expansion_ * thetaOf(elements_[t]);
+        if (!elementAlive(t)) continue;
+        const double stretch = 1.0 + expansion_ * thetaOf(elements_[t], s.theta);
         if (!maxStrain_.empty())
             yieldElement(t, stretchesOf(deformationGradient(elements_[t], x) / stretch));
-        if (breakable && pastCriticalStrain(t, x)) eroding_[t] = 1;
+        if (breakable && pastCriticalStrain(t, x, s.theta)) eroding_[t] = 1;
     }
-    erodeFlagged(apart);
-    return apart;
+    erodeFlagged(true);
 }
 
-bool FemCst::cut(const std::vector<std::array<int, 2>>& edges) {
-    std::map<std::pair<int, int>, bool> isCut;
-    for (const auto& [a, b] : edges) isCut[std::minmax(a, b)] = true;
-    std::vector<std::array<int, 2>> unused;
+void FemCst::cut(const std::vector<std::array<int, 2>>&) {
+    // The notches broke their edges in the DamageState; an element with one of them as a side
+    // goes, its other sides stay whole (the bonds along them still diffuse). Flag first, so the
+    // elements removed do not depend on the order.
     for (int t = 0; t < int(elements_.size()); ++t)
-        for (int s = 0; s < 3 && alive_[t]; ++s)
-            if (isCut.count(std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3])))
-                erode(t, unused);
-    return true;
+        for (const int e : damage_->triangleEdges(elements_[t].triangle))
+            if (!damage_->edgeIntact(e)) eroding_[t] = 1;
+    erodeFlagged(false);
 }
 
-double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+double FemCst::strainEnergy(const StepState& s, Workspace&) const {
+    const std::span<const Eigen::Vector3d> x = s.x;
     double sum = 0.0;
     for (int t = 0; t < int(elements_.size()); ++t) {
-        if (!alive_[t]) continue;
-        const double theta = thetaOf(elements_[t]), stretch = 1.0 + expansion_ * theta;
+        if (!elementAlive(t)) continue;
+        const double theta = thetaOf(elements_[t], s.theta), stretch = 1.0 + expansion_ * theta;
         const Eigen::Matrix2d E =
             0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
                    Eigen::Matrix2d::Identity());
@@ -391,62 +387,47 @@ double FemCst::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
             const Eigen::Matrix<double, 3, 2> F = deformationGradient(elements_[t], x) / stretch;
             nonlinearStress(t, F, stretchesOf(F), &density);
         }
-        sum += elements_[t].restArea * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * theta) *
-               density;
+        sum += elements_[t].restArea * thickness_ * material_.stiffnessFactor(theta) * density;
     }
     return sum;
 }
 
-std::vector<std::array<int, 2>> FemCst::advance(const std::vector<Eigen::Vector3d>& x,
-                                                const std::vector<Eigen::Vector3d>& v, double dt,
-                                                std::vector<Eigen::Vector3d>& force) {
-    std::vector<std::array<int, 2>> apart;
-    const double lowest = elementPass<true>(x, force, &v, dt);
-    erodeFlagged(apart);
+void FemCst::advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) {
+    fracture(s, work);
+    forces(s, work, force);
     // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
+    const double lowest = static_cast<FemWorkspace&>(work).lowest;
     stiffening_ = law_.kind == BondLawKind::PowerLaw
-                      ? std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)))
+                      ? std::max(1.0, law_.powerLawStiffening(clampCompression(lowest)))
                       : 1.0;
-    return apart;
 }
 
 double FemCst::strengthLeft(int t) const {
     return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t]});
 }
 
-void FemCst::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
-    bondEnds_.clear();
-    bondElements_.clear();
+void FemCst::reportStrength(DamageState& damage) const {
     if (maxStrain_.empty()) return;  // only the elastoplastic law loses strength
-    std::map<std::pair<int, int>, std::array<int, 2>> holders;  // side -> its elements
-    for (int t = 0; t < int(elements_.size()); ++t)
-        for (int s = 0; s < 3; ++s) {
-            const auto key = std::minmax(elements_[t].v[(s + 1) % 3], elements_[t].v[(s + 2) % 3]);
-            holders.try_emplace(key, std::array<int, 2>{t, elements_[t].across[s]});
-        }
-    bondEnds_.resize(partners.size());
-    bondElements_.assign(partners.size(), {-1, -1});
-    for (int i = 0; i + 1 < int(offsets.size()); ++i)
-        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
-            bondEnds_[b] = {i, partners[b]};
-            if (const auto it = holders.find(std::minmax(i, partners[b])); it != holders.end())
-                bondElements_[b] = it->second;
-        }
+    const BondFamilies& bonds = *sharedBonds_;
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+            damage.weaken(b, bondStrength(b, i, bonds.partners[b]));
 }
 
-double FemCst::bondStrengthLeft(int bond) const {
-    if (bondEnds_.empty()) return 1.0;
+double FemCst::bondStrength(int b, int i, int j) const {
     double sum = 0.0;
     int count = 0;
-    for (int t : bondElements_[bond])
-        if (t >= 0 && alive_[t]) sum += strengthLeft(t), ++count;
+    if (const int edge = damage_->bondEdge(b); edge >= 0)
+        for (int triangle : damage_->edgeTriangles(edge))
+            if (const int t = triangle >= 0 ? elementOf_[triangle] : -1; t >= 0 && elementAlive(t))
+                sum += strengthLeft(t), ++count;
     if (count > 0) return sum / count;
     double ends = 0.0;
-    for (int i : bondEnds_[bond]) {  // a bond no element side carries: its ends' mean
+    for (int end : {i, j}) {  // a bond no element side carries: its ends' mean
         double own = 0.0;
         int held = 0;
-        for (int k = cornerOffsets_[i]; k < cornerOffsets_[i + 1]; ++k)
-            if (const int t = corners_[k] / 3; alive_[t]) own += strengthLeft(t), ++held;
+        for (int k = cornerOffsets_[end]; k < cornerOffsets_[end + 1]; ++k)
+            if (const int t = corners_[k] / 3; elementAlive(t)) own += strengthLeft(t), ++held;
         ends += held > 0 ? own / held : 1.0;
     }
     return 0.5 * ends;

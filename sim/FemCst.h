@@ -35,10 +35,13 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <array>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "sim/BondLaw.h"
 #include "sim/Lattice.h"
+#include "sim/Material.h"
 #include "sim/Params.h"
 #include "sim/Solver.h"
 
@@ -50,31 +53,33 @@ public:
     /// 1 + criticalStrain (infinity: never).
     /// The material's thermal strain alpha theta and its stiffness and strength losses apply
     /// per element, with theta averaged over its corners.
-    FemCst(const Lattice& lattice, const MaterialParams& material, double thickness,
+    FemCst(const Lattice& lattice, const Material& material, double thickness,
            double criticalStrain);
+    /// The registry's factory: breaks at bandCriticalStrain().
+    static std::unique_ptr<Solver> make(const SolverSetUp& s);
 
-    void forces(const std::vector<Eigen::Vector3d>& x,
+    std::unique_ptr<Workspace> makeWorkspace() const override;
+    /// With s.v (and the power law), also the smallest principal Biot strain looked ahead by
+    /// s.dt at its current rate, into the workspace, for advance().
+    void forces(const StepState& s, Workspace& work,
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
-    double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
-    /// Yields the elastoplastic elements (their history step), then erodes.
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    double strainEnergy(const StepState& s, Workspace& work) const override;
+    /// Yields the elastoplastic elements (their history step), then erodes those past the
+    /// critical strain, in index order.
+    void fracture(const StepState& s, Workspace& work) override;
     /// fracture(), forces(), and for the power law the stiffening of the most compressed
     /// principal stretch, looked ahead by dt at its current rate.
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
+    void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
     /// A bond along an element side: the mean gamma of the living elements holding it; any
     /// other bond: the mean of its two ends' (each the mean over its living elements).
-    double bondStrengthLeft(int bond) const override;
-    void bindBonds(std::span<const int> offsets, std::span<const int> partners) override;
+    void reportStrength(DamageState& damage) const override;
     /// A notch removes every element with a cut side (a gap one element wide).
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
-    std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
+    void cut(const std::vector<std::array<int, 2>>& edges) override;
 
     /// Green strain of triangle t at positions x, in its rest frame (first axis along edge 01).
-    Eigen::Matrix2d greenStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
+    Eigen::Matrix2d greenStrain(int t, std::span<const Eigen::Vector3d> x) const;
     int elementCount() const { return int(elements_.size()); }
     /// Largest equivalent strain T the element reached (elastoplastic law; 0 otherwise).
     double maxStrain(int t) const { return maxStrain_.empty() ? 0.0 : maxStrain_[t]; }
@@ -91,11 +96,15 @@ private:
     };
     void findNeighbours();
     /// Mean theta over the element's corners (0 without diffusion).
-    double thetaOf(const Element& e) const;
-    /// Removes element t and returns the sides no living element holds any more.
-    void erode(int t, std::vector<std::array<int, 2>>& apart);
+    static double thetaOf(const Element& e, std::span<const double> theta);
+    /// Removes element t's triangle from the DamageState, and with `breakSides` breaks the
+    /// sides no living element holds any more.
+    void erode(int t, bool breakSides);
+    bool elementAlive(int t) const { return damage_->triangleAlive()[elements_[t].triangle]; }
+    /// eq. 27's gamma of bond b from i to j (see reportStrength()).
+    double bondStrength(int b, int i, int j) const;
     Eigen::Matrix<double, 3, 2> deformationGradient(const Element& e,
-                                                    const std::vector<Eigen::Vector3d>& x) const;
+                                                    std::span<const Eigen::Vector3d> x) const;
     /// Power law and elastoplastic: the second Piola stress S of element t at the mechanical
     /// deformation F (thermal stretch removed), before the stiffness loss; energy density into
     /// `energy` when asked.
@@ -112,40 +121,36 @@ private:
                                     const Stretches& principal, double* energy,
                                     const Eigen::Matrix<double, 3, 2>* rate = nullptr,
                                     double dt = 0.0, double* lowest = nullptr) const;
-    /// One parallel pass over the elements, then the gather into `force`. With kAdvance (a
-    /// step's advance()) it also yields elastoplastic elements and flags in `eroding_` those
-    /// past the critical strain, which carry nothing from this step on; without, it writes
-    /// nothing but the forces. Velocities v give the power law's look-ahead. Returns the
-    /// smallest principal Biot strain (0 when none is compressed; linear law: 0).
-    template <bool kAdvance>
-    double elementPass(const std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& force,
-                       const std::vector<Eigen::Vector3d>* v, double dt);
+    /// The forces' scratch: per element corner (element * 3 + corner) its force, and the
+    /// smallest principal Biot strain looked ahead (0 when none is compressed).
+    struct FemWorkspace : Workspace {
+        std::vector<Eigen::Vector3d> cornerForce;
+        double lowest = 0.0;
+    };
     /// Elastoplastic history step of element t at the mechanical deformation F.
     void yieldElement(int t, const Stretches& principal);
     /// Whether element t is past the critical strain at x: its largest principal Green strain
     /// of the mechanical part against the critical stretch's, both weakened by theta.
-    bool pastCriticalStrain(int t, const std::vector<Eigen::Vector3d>& x) const;
-    /// Removes the flagged elements in index order (so the sides reported do not depend on
-    /// the thread count) and clears the flags.
-    void erodeFlagged(std::vector<std::array<int, 2>>& apart);
+    bool pastCriticalStrain(int t, std::span<const Eigen::Vector3d> x,
+                            std::span<const double> theta) const;
+    /// Removes the flagged elements in index order (so the sides broken do not depend on
+    /// the thread count) and clears the flags; see erode() for `breakSides`.
+    void erodeFlagged(bool breakSides);
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each
     // particle sums its own forces and the loop needs no atomics (and no ordering by thread).
     std::vector<int> cornerOffsets_, corners_;
-    std::vector<Eigen::Vector3d> cornerForce_;
-    double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0, criticalStrain_ = 0.0;
-    double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
+    Material material_;
+    double lambda_ = 0.0, mu_ = 0.0;  ///< the material's plane-stress Lame constants
+    double thickness_ = 0.0, criticalStrain_ = 0.0, expansion_ = 0.0;
     BondLaw law_;  ///< the material's law at unit stiffness (c = 1): its shape f/c
     // Elastoplastic history per element: plastic Biot strain (rest frame) and T.
     std::vector<Eigen::Matrix2d> plasticStrain_;
     std::vector<double> maxStrain_;
     double stiffening_ = 1.0;
     std::vector<std::uint8_t> eroding_;  ///< per element: past the critical strain this step
-    // bindBonds: per bond, its ends and the elements holding it as a side (-1: none).
-    std::vector<std::array<int, 2>> bondEnds_, bondElements_;
-    std::vector<std::uint8_t> alive_;          ///< per element
-    std::vector<std::uint8_t> triangleAlive_;  ///< per lattice triangle, for the FrameView
+    std::vector<int> elementOf_;         ///< per lattice triangle, its element or -1 (degenerate)
 };
 
 /// Per particle, the corners (element * 3 + corner) of the triangles that contain it, in CSR.

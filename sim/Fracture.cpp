@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace rend::sim {
@@ -10,6 +11,23 @@ double calibratedCriticalStretch(double fractureEnergy, double micromodulus,
                                  double interiorWeightedMoment) {
     return std::sqrt(2.0 * std::numbers::pi * fractureEnergy /
                      (micromodulus * interiorWeightedMoment));
+}
+
+double springCriticalStrain(const MembraneParams& params) {
+    const MaterialParams& m = params.material;
+    if (!m.fractureEnergy) return std::numeric_limits<double>::infinity();
+    // The springs crossing a unit length of crack along a hexagonal row (2 / dx of them, each
+    // sqrt(3)/2 E h at nu = 1/3) store G_f h at this strain: k eps^2 dx^2 / 2 * 2 / dx = G_f h.
+    return std::sqrt(2.0 * *m.fractureEnergy /
+                     (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
+}
+
+double bandCriticalStrain(const MembraneParams& params) {
+    // An eroded element (or a two-parameter triangle with a broken side) releases only its own
+    // energy: the band the crack takes out, sqrt(3)/2 dx high, at E eps^2 / (2 (1 - nu^2)),
+    // holds G_f h per unit length at sqrt(2 (1 - nu^2)) times the springs' strain.
+    const double nu = params.material.poissonRatio;
+    return std::sqrt(2.0 * (1.0 - nu * nu)) * springCriticalStrain(params);
 }
 
 double paperCriticalStretch(double fractureEnergy, double youngsModulus, double horizon) {
@@ -46,20 +64,17 @@ bool crossesAnyNotch(const Eigen::Vector2d& p, const Eigen::Vector2d& q,
 
 }  // namespace
 
-std::size_t applyNotches(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
-                         BondFamilies& bonds) {
-    std::size_t broken = 0;
+std::vector<int> notchedBonds(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
+                              const BondFamilies& bonds) {
+    std::vector<int> crossing;
     for (int i = 0; i < bonds.particleCount(); ++i)
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
             // Both copies of a bond are tested with the lower index first, so they agree even
             // where the tie-break of segmentsCross decides.
             if (const int lo = std::min(i, bonds.partners[b]), hi = std::max(i, bonds.partners[b]);
-                bonds.alive[b] &&
-                crossesAnyNotch(rest[lo].head<2>(), rest[hi].head<2>(), notches)) {
-                bonds.alive[b] = 0;
-                ++broken;
-            }
-    return broken / 2;  // each bond is stored from both ends, and both ends cross alike
+                crossesAnyNotch(rest[lo].head<2>(), rest[hi].head<2>(), notches))
+                crossing.push_back(b);
+    return crossing;
 }
 
 }  // namespace rend::sim

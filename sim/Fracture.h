@@ -30,14 +30,21 @@ double calibratedCriticalStretch(double fractureEnergy, double micromodulus,
 /// Eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R)).
 double paperCriticalStretch(double fractureEnergy, double youngsModulus, double horizon);
 
+/// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
+/// lattice row store the fracture energy G_f (infinity without one).
+double springCriticalStrain(const MembraneParams& params);
+
+/// Critical strain of the FEM elements and the two-parameter springs, whose cracks take out a
+/// band of elements (triangles) one row high: sqrt(2 (1 - nu^2)) times the springs'.
+double bandCriticalStrain(const MembraneParams& params);
+
 /// Whether segments pq and ab cross. A point exactly on the other segment's line counts as on
 /// its left, so a notch along a lattice row cuts the bonds below that row and no others.
 bool segmentsCross(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& a,
                    const Eigen::Vector2d& b);
 
-/// Breaks (both copies of) every bond whose rest segment crosses a notch. Returns the number
-/// of bonds broken.
-std::size_t applyNotches(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
-                         BondFamilies& bonds);
+/// Both copies of every bond whose rest segment crosses a notch, in index order.
+std::vector<int> notchedBonds(std::span<const Notch> notches, std::span<const Eigen::Vector3d> rest,
+                              const BondFamilies& bonds);
 
 }  // namespace rend::sim

@@ -29,12 +29,15 @@ struct FrameView {
     std::span<const int> bondOffsets;
     std::span<const int> bondPartners;
     std::span<const double> bondRestLength;
-    /// 1 intact, 0 broken. The two copies of a bond (i->j and j->i) always agree: the solver
-    /// breaks a bond from both ends, so a reader may look at either.
+    /// 1 intact, 0 broken. The two copies of a bond (i->j and j->i) always agree: the
+    /// DamageState breaks a bond from both ends, so a reader may look at either.
     std::span<const std::uint8_t> bondAlive;
-    /// Per rest triangle, 0 once the solver removed it (the FEM's element erosion); empty when
-    /// no solver removes triangles. A surface drops a removed triangle like a broken one.
-    std::span<const std::uint8_t> triangleAlive;
+    /// Per rest triangle, 1 while it is kept: not removed (the FEM's element erosion) and none
+    /// of its edges broken. Every surface and the pressure load read this one flag; empty
+    /// means every triangle is kept.
+    std::span<const std::uint8_t> keptTriangles;
+
+    bool triangleKept(std::size_t t) const { return keptTriangles.empty() || keptTriangles[t]; }
 
     std::size_t particleCount() const { return positions.size(); }
 

@@ -3,25 +3,23 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 #include <stdexcept>
 
+#include "sim/Fracture.h"
 #include "sim/Parallel.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 
-MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const MaterialParams& material,
+MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material& material,
                        double thickness, double criticalStrain)
     : model_(model),
-      poisson_(material.poissonRatio),
-      law_(BondLaw::fromMaterial(material, 1.0)),
-      expansion_(material.expansion),
-      stiffnessLoss_(material.stiffnessLoss),
-      strengthLoss_(material.strengthLoss),
+      material_(material),
+      poisson_(material.poissonRatio()),
+      law_(material.law(1.0)),
+      expansion_(material.expansion()),
       criticalStrain_(criticalStrain) {
-    if (!(poisson_ > -1.0 && poisson_ < 0.5))
-        throw std::invalid_argument("mass-spring solvers need -1 < poisson < 0.5");
-    const double E = material.youngsModulus, t = thickness, nu = poisson_;
+    const double E = material.youngsModulus(), t = thickness, nu = poisson_;
     const auto& p = lattice.positions;
     std::map<std::pair<int, int>, int> index;
     auto springOf = [&](int a, int b) {
@@ -31,7 +29,7 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         return it->second;
     };
     for (const auto& v : lattice.triangles) {
-        Triangle tri{v, {}, {}, 0.0, 0.0};
+        Triangle tri{v, {}, {}, 0.0, 0.0, int(&v - lattice.triangles.data())};
         for (int s = 0; s < 3; ++s) {
             const int a = v[(s + 1) % 3], b = v[(s + 2) % 3];
             tri.side[s] = springOf(a, b);
@@ -62,74 +60,73 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         particleSprings_[fill[springs_[s].i]++] = s + 1;
         particleSprings_[fill[springs_[s].j]++] = -(s + 1);
     }
-    tension_.resize(springs_.size());
-    triangleTension_.resize(triangles_.size());
-    springAlive_.assign(springs_.size(), 1);
-    if (material.law == BondLawKind::Elastoplastic) plastic_.assign(springs_.size(), {});
-    triangleIntact_.assign(triangles_.size(), 1);
-    springTriangles_.assign(springs_.size(), {-1, -1});
-    for (int k = 0; k < int(triangles_.size()); ++k)
-        for (int side : triangles_[k].side)
-            springTriangles_[side][springTriangles_[side][0] >= 0] = k;
+    if (law_.kind == BondLawKind::Elastoplastic) plastic_.assign(springs_.size(), {});
+    bindOwn({}, n, lattice.triangles);
 }
 
-void MassSpring::breakSpring(int s) {
-    springAlive_[s] = 0;
-    for (int k : springTriangles_[s])
-        if (k >= 0) triangleIntact_[k] = 0;
+std::unique_ptr<Solver> MassSpring::makeVanGelder(const SolverSetUp& s) {
+    return std::make_unique<MassSpring>(s.lattice, SpringModel::VanGelder, s.material,
+                                        s.params.sheet.thickness, springCriticalStrain(s.params));
 }
 
-std::vector<std::array<int, 2>> MassSpring::fracture(const std::vector<Eigen::Vector3d>& x) {
-    std::vector<std::array<int, 2>> apart;
-    if (plastic_.empty() && !std::isfinite(criticalStrain_)) return apart;  // nothing to record
+std::unique_ptr<Solver> MassSpring::makeTwoParameter(const SolverSetUp& s) {
+    return std::make_unique<MassSpring>(s.lattice, SpringModel::TwoParameter, s.material,
+                                        s.params.sheet.thickness, bandCriticalStrain(s.params));
+}
+
+void MassSpring::onBind() {
+    const auto& edges = damage_->edges();
+    bool same = edges.size() == springs_.size();
+    for (std::size_t s = 0; same && s < springs_.size(); ++s)
+        same = edges[s] == std::array<int, 2>{springs_[s].i, springs_[s].j};
+    if (!same) throw std::logic_error("the springs are not the damage state's edges");
+}
+
+std::unique_ptr<Workspace> MassSpring::makeWorkspace() const {
+    auto work = std::make_unique<SpringWorkspace>();
+    work->tension.resize(springs_.size());
+    work->triangleTension.resize(triangles_.size());
+    return work;
+}
+
+void MassSpring::fracture(const StepState& state, Workspace&) {
+    if (plastic_.empty() && !std::isfinite(criticalStrain_)) return;  // nothing to record
     for (int s = 0; s < int(springs_.size()); ++s) {
-        if (!springAlive_[s]) continue;
+        if (!springAlive(s)) continue;
         double thetaBar;
-        const double eta = mechanicalStrain(s, x, thetaBar);
+        const double eta = mechanicalStrain(s, state, thetaBar);
         if (!plastic_.empty()) plastic_[s] = law_.yieldStep(eta, plastic_[s]);  // eq. 20
-        if (!(eta > criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar))) continue;
-        breakSpring(s);
-        apart.push_back({springs_[s].i, springs_[s].j});
+        if (!(eta > criticalStrain_ * material_.strengthFactor(thetaBar))) continue;
+        damage_->breakEdge(s);  // serial, in spring order
     }
-    return apart;
 }
 
-std::vector<std::array<int, 2>> MassSpring::advance(const std::vector<Eigen::Vector3d>& x,
-                                                    const std::vector<Eigen::Vector3d>& v,
-                                                    double dt,
-                                                    std::vector<Eigen::Vector3d>& force) {
-    std::vector<std::array<int, 2>> apart = fracture(x);
+void MassSpring::advance(const StepState& state, Workspace& work,
+                         std::vector<Eigen::Vector3d>& force) {
+    fracture(state, work);
     if (law_.kind == BondLawKind::PowerLaw)  // the clamp is the peridynamic loop's
-        stiffening_ =
-            std::max(1.0, law_.powerLawStiffening(std::max(lowestStrain(x, v, dt), -0.95)));
-    forces(x, force);
-    return apart;
+        stiffening_ = std::max(1.0, law_.powerLawStiffening(clampCompression(lowestStrain(state))));
+    forces(state, work, force);
 }
 
-void MassSpring::bindBonds(std::span<const int> offsets, std::span<const int> partners) {
-    bondSpring_.assign(partners.size(), -1);
-    for (int s = 0; s < int(springs_.size()); ++s)
-        for (const auto& [a, b] :
-             {std::pair{springs_[s].i, springs_[s].j}, std::pair{springs_[s].j, springs_[s].i}})
-            for (int bond = offsets[a]; bond < offsets[a + 1]; ++bond)
-                if (partners[bond] == b) bondSpring_[bond] = s;
+void MassSpring::reportStrength(DamageState& damage) const {
+    if (plastic_.empty()) return;
+    for (int b = 0; b < int(damage.bondAlive().size()); ++b)
+        if (const int s = damage.bondEdge(b); s >= 0)
+            damage.weaken(b, law_.strengthLeft(plastic_[s]));  // eq. 27's gamma of the side
 }
 
-double MassSpring::bondStrengthLeft(int bond) const {
-    if (plastic_.empty() || bondSpring_.empty()) return 1.0;
-    const int s = bondSpring_[bond];
-    return s < 0 ? 1.0 : law_.strengthLeft(plastic_[s]);  // eq. 27's gamma of the side strain
-}
-
-double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
-                                const std::vector<Eigen::Vector3d>& v, double dt) const {
+double MassSpring::lowestStrain(const StepState& state) const {
+    const auto& x = state.x;
+    const auto& v = state.v;
+    const double dt = state.dt;
     double lowest = 0.0;
     const int count = int(springs_.size());
 #pragma omp parallel for schedule(static) reduction(min : lowest) if (count >= kParallelThreshold)
     for (int s = 0; s < count; ++s) {
-        if (!springAlive_[s]) continue;
+        if (!springAlive(s)) continue;
         double thetaBar;
-        const double eta = mechanicalStrain(s, x, thetaBar);
+        const double eta = mechanicalStrain(s, state, thetaBar);
         if (eta >= 0.0) continue;
         const Spring& sp = springs_[s];
         const Eigen::Vector3d r = x[sp.j] - x[sp.i];
@@ -139,57 +136,51 @@ double MassSpring::lowestStrain(const std::vector<Eigen::Vector3d>& x,
     return lowest;
 }
 
-bool MassSpring::cut(const std::vector<std::array<int, 2>>& edges) {
-    std::set<std::pair<int, int>> cuts;  // springs are stored with i < j
-    for (const auto& [a, b] : edges) cuts.insert(std::minmax(a, b));
-    for (int s = 0; s < int(springs_.size()); ++s)
-        if (cuts.count({springs_[s].i, springs_[s].j})) breakSpring(s);
-    return true;
-}
-
-double MassSpring::mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x,
-                                    double& thetaBar) const {
+double MassSpring::mechanicalStrain(int s, const StepState& state, double& thetaBar) const {
     const Spring& sp = springs_[s];
-    thetaBar = theta_.empty() ? 0.0 : 0.5 * (theta_[sp.i] + theta_[sp.j]);
+    const auto& x = state.x;
+    const auto& theta = state.theta;
+    thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[sp.i] + theta[sp.j]);
     return (x[sp.j] - x[sp.i]).norm() / sp.restLength - 1.0 - expansion_ * thetaBar;
 }
 
-void MassSpring::tensions(const std::vector<Eigen::Vector3d>& x) const {
+void MassSpring::tensions(const StepState& state, SpringWorkspace& work) const {
+    std::vector<double>& tension = work.tension;
     const int count = int(springs_.size());
     if (model_ == SpringModel::VanGelder) {
 #pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
         for (int s = 0; s < count; ++s) {
-            if (!springAlive_[s]) {
-                tension_[s] = 0.0;
+            if (!springAlive(s)) {
+                tension[s] = 0.0;
                 continue;
             }
             double thetaBar;
-            const double eta = mechanicalStrain(s, x, thetaBar);
-            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[s];
-            tension_[s] = springs_[s].k * springs_[s].restLength * law_.force(eta, state) *
-                          std::max(0.0, 1.0 - stiffnessLoss_ * thetaBar);
+            const double eta = mechanicalStrain(s, state, thetaBar);
+            const PlasticState plastic = plastic_.empty() ? PlasticState{} : plastic_[s];
+            tension[s] = springs_[s].k * springs_[s].restLength * law_.force(eta, plastic) *
+                         material_.stiffnessFactor(thetaBar);
         }
         return;
     }
     switch (law_.kind) {
         case BondLawKind::Linear:
-            return twoParameterTensions<BondLawKind::Linear>(x);
+            return twoParameterTensions<BondLawKind::Linear>(state, work);
         case BondLawKind::PowerLaw:
-            return twoParameterTensions<BondLawKind::PowerLaw>(x);
+            return twoParameterTensions<BondLawKind::PowerLaw>(state, work);
         case BondLawKind::Elastoplastic:
-            return twoParameterTensions<BondLawKind::Elastoplastic>(x);
+            return twoParameterTensions<BondLawKind::Elastoplastic>(state, work);
     }
 }
 
-MassSpring::SideStrains MassSpring::sideStrains(int k,
-                                                const std::vector<Eigen::Vector3d>& x) const {
+MassSpring::SideStrains MassSpring::sideStrains(int k, const StepState& state) const {
     const Triangle& tri = triangles_[k];
+    const auto& thetas = state.theta;
     double theta = 0.0;
-    if (!theta_.empty()) theta = (theta_[tri.v[0]] + theta_[tri.v[1]] + theta_[tri.v[2]]) / 3;
-    return sideStrains(x, tri.v, tri.restLength, tri.restArea, theta);
+    if (!thetas.empty()) theta = (thetas[tri.v[0]] + thetas[tri.v[1]] + thetas[tri.v[2]]) / 3;
+    return sideStrains(state.x, tri.v, tri.restLength, tri.restArea, theta);
 }
 
-MassSpring::SideStrains MassSpring::sideStrains(const std::vector<Eigen::Vector3d>& x,
+MassSpring::SideStrains MassSpring::sideStrains(std::span<const Eigen::Vector3d> x,
                                                 const std::array<int, 3>& v,
                                                 const std::array<double, 3>& restLength,
                                                 double restArea, double theta) const {
@@ -212,16 +203,19 @@ MassSpring::SideStrains MassSpring::sideStrains(const std::vector<Eigen::Vector3
 // Each triangle's share of its three sides' tensions, then the sum per side in a fixed order
 // (triangle by triangle), so the result does not depend on threads.
 template <BondLawKind K>
-void MassSpring::twoParameterTensions(const std::vector<Eigen::Vector3d>& x) const {
+void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& work) const {
+    const auto& x = state.x;
+    std::vector<double>& tension = work.tension;
+    std::vector<std::array<double, 3>>& triangleTension = work.triangleTension;
     const int triangles = int(triangles_.size());
 #pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
     for (int k = 0; k < triangles; ++k) {
         const Triangle& tri = triangles_[k];
-        if (!triangleIntact_[k]) {
-            triangleTension_[k] = {0.0, 0.0, 0.0};
+        if (!damage_->keptTriangles()[tri.triangle]) {
+            triangleTension[k] = {0.0, 0.0, 0.0};
             continue;
         }
-        SideStrains e = sideStrains(k, x);
+        SideStrains e = sideStrains(k, state);
         // Elastoplastic: the rest triangle of sides l0 (1 + p), p the springs' permanent strains
         // (on the loading path, eq. 20's at the current strain). Left at l0 while elastic.
         std::array<double, 3> rest = tri.restLength;
@@ -240,7 +234,7 @@ void MassSpring::twoParameterTensions(const std::vector<Eigen::Vector3d>& x) con
                 restArea = 0.25 * std::sqrt(std::max(heron, 0.0));
                 // A plastic flow that flattens the triangle leaves it nothing to carry.
                 if (!(restArea > 1e-3 * tri.restArea)) {
-                    triangleTension_[k] = {0.0, 0.0, 0.0};
+                    triangleTension[k] = {0.0, 0.0, 0.0};
                     continue;
                 }
                 fixedPart *= tri.restArea / restArea;  // eq. 12 for the new rest triangle
@@ -255,30 +249,33 @@ void MassSpring::twoParameterTensions(const std::vector<Eigen::Vector3d>& x) con
         const double all = l0sq[0] * q[0] + l0sq[1] * q[1] + l0sq[2] * q[2];
         // The rest shape's scale s multiplies the forces (b0 Q a0^2 ~ s).
         const double stretch = 1.0 + expansion_ * e.theta;
-        const double scale = stretch * std::max(0.0, 1.0 - stiffnessLoss_ * e.theta);
+        const double scale = stretch * material_.stiffnessFactor(e.theta);
         for (int s = 0; s < 3; ++s)  // eqs. 13-14 times eps_b b0
-            triangleTension_[k][s] = scale * fixedPart * rest[s] * (all - 2.0 * l0sq[s] * q[s]);
+            triangleTension[k][s] = scale * fixedPart * rest[s] * (all - 2.0 * l0sq[s] * q[s]);
     }
-    std::fill(tension_.begin(), tension_.end(), 0.0);
+    std::fill(tension.begin(), tension.end(), 0.0);
     for (int k = 0; k < triangles; ++k)
-        for (int s = 0; s < 3; ++s) tension_[triangles_[k].side[s]] += triangleTension_[k][s];
+        for (int s = 0; s < 3; ++s) tension[triangles_[k].side[s]] += triangleTension[k][s];
     if constexpr (K == BondLawKind::PowerLaw) {  // each spring's secant phi(eta) / eta
         const int count = int(springs_.size());
 #pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
         for (int s = 0; s < count; ++s) {
             double thetaBar;
-            const double eta = mechanicalStrain(s, x, thetaBar);
+            const double eta = mechanicalStrain(s, state, thetaBar);
             // Below 1e-6 the secant is 1 to within phi''(0) 1e-6: a part in a million of a
             // tension that is itself a millionth of the stiffness.
-            if (std::abs(eta) > 1e-6) tension_[s] *= law_.forceAs<K>(eta) / eta;
+            if (std::abs(eta) > 1e-6) tension[s] *= law_.forceAs<K>(eta) / eta;
         }
     }
 }
 
-void MassSpring::forces(const std::vector<Eigen::Vector3d>& x,
+void MassSpring::forces(const StepState& state, Workspace& work,
                         std::vector<Eigen::Vector3d>& force) const {
-    tensions(x);
+    SpringWorkspace& springs = static_cast<SpringWorkspace&>(work);
+    tensions(state, springs);
+    const auto& x = state.x;
     const int n = int(x.size());
+    force.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -287,7 +284,7 @@ void MassSpring::forces(const std::vector<Eigen::Vector3d>& x,
             const Spring& sp = springs_[std::abs(code) - 1];
             const int other = code > 0 ? sp.j : sp.i;
             const Eigen::Vector3d r = x[other] - x[i];
-            sum += tension_[std::abs(code) - 1] / r.norm() * r;
+            sum += springs.tension[std::abs(code) - 1] / r.norm() * r;
         }
         force[i] = sum;
     }
@@ -308,24 +305,26 @@ std::vector<double> MassSpring::stiffnessRowSums(int particleCount) const {
     return sums;
 }
 
-double MassSpring::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+double MassSpring::strainEnergy(const StepState& state, Workspace& work) const {
+    const auto& x = state.x;
     double sum = 0.0;
     if (model_ == SpringModel::VanGelder) {  // k L0^2 Psi(eta), Psi the law's energy at c = 1
         for (int s = 0; s < int(springs_.size()); ++s) {
-            if (!springAlive_[s]) continue;
+            if (!springAlive(s)) continue;
             double thetaBar;
-            const double eta = mechanicalStrain(s, x, thetaBar);
-            const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[s];
+            const double eta = mechanicalStrain(s, state, thetaBar);
+            const PlasticState plastic = plastic_.empty() ? PlasticState{} : plastic_[s];
             sum += springs_[s].k * springs_[s].restLength * springs_[s].restLength *
-                   law_.energy(eta, state) * std::max(0.0, 1.0 - stiffnessLoss_ * thetaBar);
+                   law_.energy(eta, plastic) * material_.stiffnessFactor(thetaBar);
         }
         return sum;
     }
     // The two-parameter forces are not the gradient of an energy; report the springs' energy at
     // their current tensions, 1/2 T (l - l0).
-    tensions(x);
+    SpringWorkspace& springs = static_cast<SpringWorkspace&>(work);
+    tensions(state, springs);
     for (int s = 0; s < int(springs_.size()); ++s)
-        sum += 0.5 * tension_[s] *
+        sum += 0.5 * springs.tension[s] *
                ((x[springs_[s].j] - x[springs_[s].i]).norm() - springs_[s].restLength);
     return sum;
 }

@@ -45,11 +45,13 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "sim/BondLaw.h"
 #include "sim/Lattice.h"
+#include "sim/Material.h"
 #include "sim/Solver.h"
 
 namespace rend::sim {
@@ -61,22 +63,23 @@ public:
     /// criticalStrain: a spring breaks once stretched past it (infinity: never). Both models
     /// take the material's bond law (its shape, see above), its thermal strain alpha theta_bar
     /// and its stiffness and strength losses, as the bonds do.
-    MassSpring(const Lattice& lattice, SpringModel model, const MaterialParams& material,
+    MassSpring(const Lattice& lattice, SpringModel model, const Material& material,
                double thickness, double criticalStrain);
+    /// The registry's factories: Van Gelder's springs break at springCriticalStrain(), the
+    /// two-parameter ones (whose triangles go with a side) at bandCriticalStrain().
+    static std::unique_ptr<Solver> makeVanGelder(const SolverSetUp& s);
+    static std::unique_ptr<Solver> makeTwoParameter(const SolverSetUp& s);
 
-    void forces(const std::vector<Eigen::Vector3d>& x,
+    std::unique_ptr<Workspace> makeWorkspace() const override;
+    void forces(const StepState& s, Workspace& work,
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
-    double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
+    double strainEnergy(const StepState& s, Workspace& work) const override;
+    void fracture(const StepState& s, Workspace& work) override;
+    void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
     /// Each of the Membrane's bonds along a spring reports that spring's strength left.
-    void bindBonds(std::span<const int> offsets, std::span<const int> partners) override;
-    double bondStrengthLeft(int bond) const override;
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
+    void reportStrength(DamageState& damage) const override;
 
     int springCount() const { return int(springs_.size()); }
     /// Van Gelder's k of spring s (eq. 1) [N/m].
@@ -94,11 +97,18 @@ private:
         std::array<double, 3> restLength;
         double restArea;
         double fixedPart;  ///< Q (eq. 12)
+        int triangle;      ///< index into the lattice's triangles
     };
-    /// Tension of every spring [N] at x.
-    void tensions(const std::vector<Eigen::Vector3d>& x) const;
+    /// The forces' scratch: every spring's tension [N] and each two-parameter triangle's share
+    /// of its sides' (summed per side in triangle order).
+    struct SpringWorkspace : Workspace {
+        std::vector<double> tension;
+        std::vector<std::array<double, 3>> triangleTension;
+    };
+    /// Tension of every spring [N] at state.x into the workspace.
+    void tensions(const StepState& state, SpringWorkspace& work) const;
     template <BondLawKind K>
-    void twoParameterTensions(const std::vector<Eigen::Vector3d>& x) const;
+    void twoParameterTensions(const StepState& state, SpringWorkspace& work) const;
 
     /// Per intact two-parameter triangle k and side s, the mechanical strains of eq. 9:
     /// tangent = eps_t,s, normal = eps_n,s, and the triangle's theta.
@@ -106,41 +116,39 @@ private:
         std::array<double, 3> tangent, normal;
         double theta;
     };
-    SideStrains sideStrains(int k, const std::vector<Eigen::Vector3d>& x) const;
+    SideStrains sideStrains(int k, const StepState& state) const;
     /// The same about any rest triangle of vertices v.
-    SideStrains sideStrains(const std::vector<Eigen::Vector3d>& x, const std::array<int, 3>& v,
+    SideStrains sideStrains(std::span<const Eigen::Vector3d> x, const std::array<int, 3>& v,
                             const std::array<double, 3>& restLength, double restArea,
                             double theta) const;
 
     /// The most compressed spring's strain looked ahead by dt along its rate; 0 when nothing is
     /// in compression.
-    double lowestStrain(const std::vector<Eigen::Vector3d>& x,
-                        const std::vector<Eigen::Vector3d>& v, double dt) const;
+    double lowestStrain(const StepState& state) const;
 
-    /// A broken spring carries nothing; a two-parameter triangle with a broken side carries
-    /// nothing either (its sides' forces are coupled through its shape).
-    void breakSpring(int s);
+    /// Spring s is the DamageState's edge s (both are numbered over the triangles' sides in
+    /// order). A broken spring carries nothing; a two-parameter triangle with a broken side is
+    /// no longer kept and carries nothing either (its sides' forces are coupled through its
+    /// shape).
+    bool springAlive(int s) const { return damage_->edgeIntact(s); }
+    void onBind() override;
 
     /// Mechanical strain of spring s at x (thermal strain removed) and its theta_bar.
-    double mechanicalStrain(int s, const std::vector<Eigen::Vector3d>& x, double& thetaBar) const;
+    double mechanicalStrain(int s, const StepState& state, double& thetaBar) const;
 
     SpringModel model_;
+    Material material_;
     double poisson_;
     BondLaw law_;  ///< the material's law with c = 1: tension = k L0 f(eta)
-    double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
+    double expansion_ = 0.0;
     std::vector<PlasticState> plastic_;  ///< per spring; empty unless elastoplastic
-    std::vector<int> bondSpring_;        ///< per directed bond of the Membrane, its spring or -1
     double stiffening_ = 1.0;
     double criticalStrain_;
-    std::vector<std::uint8_t> springAlive_, triangleIntact_;
-    std::vector<std::array<int, 2>> springTriangles_;  ///< the (one or two) triangles of a spring
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;
     // Per particle, its springs (signed: +s+1 when it is end i, -(s+1) when end j), so each
     // particle sums its own forces.
     std::vector<int> springOffsets_, particleSprings_;
-    mutable std::vector<double> tension_;
-    mutable std::vector<std::array<double, 3>> triangleTension_;
 };
 
 }  // namespace rend::sim

@@ -5,11 +5,9 @@
 #include <cmath>
 #include <limits>
 
-#include "sim/FemCst.h"
 #include "sim/Fracture.h"
-#include "sim/MassSpring.h"
-#include "sim/PeridynamicBonds.h"
-#include "sim/TotalLagrangianSph.h"
+#include "sim/Material.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 
@@ -26,18 +24,10 @@ Membrane::Membrane(const MembraneParams& params)
     mass_.resize(n);
     for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
-    if (params.solver == SolverKind::Peridynamic)
-        useSolver(std::make_unique<PeridynamicBonds>(params, lattice_, bonds_, x0_, volume_));
-    else
-        useSolver(makeSolver(params, lattice_));
+    damageState_ = DamageState(bonds_, lattice_.triangles);
+    const Material material(params.material);  // validated once, for every solver
+    useSolver(solverEntry(params.solver).make({params, material, lattice_, bonds_, x0_, volume_}));
     setUpNotches(params);
-    if (params.pressure != 0.0) {
-        pressureEdgeBonds_.reserve(lattice_.triangles.size());
-        for (const auto& t : lattice_.triangles)
-            pressureEdgeBonds_.push_back({findBond(bonds_, t[0], t[1]),
-                                          findBond(bonds_, t[1], t[2]),
-                                          findBond(bonds_, t[2], t[0])});
-    }
     assignBoundaries();
     x_ = x0_;
     perturb(sheet.perturbationAmplitude, sheet.perturbationSeed);
@@ -56,85 +46,28 @@ void Membrane::setStableStep(double worstRatio) {
     guard_ = BlowUpGuard(params_, worstRatio, mass_, volume_);
 }
 
-double springCriticalStrain(const MembraneParams& params) {
-    const MaterialParams& m = params.material;
-    if (!m.fractureEnergy) return std::numeric_limits<double>::infinity();
-    // The springs crossing a unit length of crack along a hexagonal row (2 / dx of them, each
-    // sqrt(3)/2 E h at nu = 1/3) store G_f h at this strain: k eps^2 dx^2 / 2 * 2 / dx = G_f h.
-    return std::sqrt(2.0 * *m.fractureEnergy /
-                     (std::sqrt(3.0) * m.youngsModulus * params.sheet.dx));
-}
-
-double bandCriticalStrain(const MembraneParams& params) {
-    // An eroded element (or a two-parameter triangle with a broken side) releases only its own
-    // energy: the band the crack takes out, sqrt(3)/2 dx high, at E eps^2 / (2 (1 - nu^2)),
-    // holds G_f h per unit length at sqrt(2 (1 - nu^2)) times the springs' strain.
-    const double nu = params.material.poissonRatio;
-    return std::sqrt(2.0 * (1.0 - nu * nu)) * springCriticalStrain(params);
-}
-
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice) {
-    const MaterialParams& m = params.material;
-    const double h = params.sheet.thickness;
-    const double critical = springCriticalStrain(params);
-    switch (params.solver) {
-        case SolverKind::FemCst:
-            return std::make_unique<FemCst>(lattice, m, h, bandCriticalStrain(params));
-        case SolverKind::MassSpringVanGelder:
-            return std::make_unique<MassSpring>(lattice, SpringModel::VanGelder, m, h, critical);
-        case SolverKind::MassSpringTwoParameter:
-            return std::make_unique<MassSpring>(lattice, SpringModel::TwoParameter, m, h,
-                                                bandCriticalStrain(params));
-        case SolverKind::Sph:
-            if (params.sheet.outline == Outline::Sphere)
-                throw std::invalid_argument("the sph solver needs a flat rest sheet");
-            return std::make_unique<TotalLagrangianSph>(
-                lattice, params.sheet.dx, m, h, params.notches,
-                m.fractureEnergy
-                    ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, params.sheet.dx)
-                    : std::numeric_limits<double>::infinity());
-        case SolverKind::Peridynamic:
-            break;
-    }
-    return nullptr;
-}
-
 void Membrane::useSolver(std::unique_ptr<Solver> solver) {
     solver_ = std::move(solver);
-    solver_->bindBonds(bonds_.offsets, bonds_.partners);
+    solver_->bind(bonds_, damageState_);
+    workspace_ = solver_->makeWorkspace();
     const std::vector<double> k = solver_->stiffnessRowSums(particleCount());
     double worstRatio = 0.0;
     for (int i = 0; i < particleCount(); ++i) worstRatio = std::max(worstRatio, k[i] / mass_[i]);
     setStableStep(worstRatio);
 }
 
-void Membrane::breakBond(int i, int j) {
-    for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}})
-        if (const int bond = findBond(bonds_, a, b); bond >= 0) bonds_.alive[bond] = 0;
-}
-
-const PeridynamicBonds& Membrane::peridynamicBonds() const {
-    const auto* bonds = dynamic_cast<const PeridynamicBonds*>(solver_.get());
-    if (!bonds) throw std::logic_error("only the peridynamic solver has bond constants");
-    return *bonds;
-}
-
-const BondLaw& Membrane::law() const { return peridynamicBonds().law(); }
-
-double Membrane::criticalStretch() const { return peridynamicBonds().criticalStretch(); }
-
 void Membrane::setUpNotches(const MembraneParams& params) {
     const MaterialParams& m = params.material;
-    notched_ = applyNotches(params.notches, x0_, bonds_);
-    if (notched_ > 0) {
-        std::vector<std::array<int, 2>> edges;
-        for (int i = 0; i < particleCount(); ++i)
-            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-                if (!bonds_.alive[b] && i < bonds_.partners[b])
-                    edges.push_back({i, bonds_.partners[b]});
-        if (!solver_->cut(edges))
-            throw std::invalid_argument("this solver cannot represent notches");
+    std::vector<std::array<int, 2>> edges;
+    for (const int b : notchedBonds(params.notches, x0_, bonds_)) {
+        damageState_.breakBond(b);
+        const int i = int(std::upper_bound(bonds_.offsets.begin(), bonds_.offsets.end(), b) -
+                          bonds_.offsets.begin()) -
+                      1;
+        if (i < bonds_.partners[b]) edges.push_back({i, bonds_.partners[b]});
     }
+    notched_ = edges.size();
+    if (notched_ > 0) solver_->cut(edges);
     canDamage_ =
         m.fractureEnergy.has_value() || m.law == BondLawKind::Elastoplastic || notched_ > 0;
 }
@@ -172,9 +105,7 @@ void Membrane::perturb(double amplitude, std::uint64_t seed) {
 }
 
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {
-    force.resize(x_.size());
-    solver_->setTheta(theta_);
-    solver_->forces(x_, force);
+    solver_->forces(stepState(), *solver_->makeWorkspace(), force);
 }
 
 Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
@@ -223,22 +154,19 @@ void Membrane::integrate(double dt, double tNext) {
 }
 
 void Membrane::accumulateForces() {
-    solver_->setTheta(theta_);
-    for (const auto& [i, j] : solver_->advance(x_, v_, dt_, force_)) breakBond(i, j);
+    solver_->advance(stepState(), *workspace_, force_);
     stiffening_ = solver_->stiffening();
-    if (!pressureEdgeBonds_.empty()) addPressure(force_);
+    if (params_.pressure != 0.0) addPressure(force_);
 }
 
-// Follower pressure: each intact triangle pushes its three corners along its current area
-// vector, p A n / 3 each. A serial loop in triangle order keeps the sums identical for any
-// thread count; it runs only when a scene sets a pressure.
+// Follower pressure: each kept triangle (DamageState::keptTriangles) pushes its three corners along
+// its current area vector, p A n / 3 each. A serial loop in triangle order keeps the sums identical
+// for any thread count; it runs only when a scene sets a pressure.
 void Membrane::addPressure(std::vector<Eigen::Vector3d>& force) const {
     const auto& triangles = lattice_.triangles;
+    const std::vector<std::uint8_t>& kept = damageState_.keptTriangles();
     for (std::size_t t = 0; t < triangles.size(); ++t) {
-        const auto& e = pressureEdgeBonds_[t];
-        if ((e[0] >= 0 && !bonds_.alive[e[0]]) || (e[1] >= 0 && !bonds_.alive[e[1]]) ||
-            (e[2] >= 0 && !bonds_.alive[e[2]]))
-            continue;
+        if (!kept[t]) continue;
         const auto& [a, b, c] = triangles[t];
         const Eigen::Vector3d area = 0.5 * (x_[b] - x_[a]).cross(x_[c] - x_[a]);
         const Eigen::Vector3d share = params_.pressure * area / 3.0;
@@ -295,7 +223,8 @@ void Membrane::step() {
     else
         stepSymplecticEuler();
     if (diffusion_) {
-        diffusion_->advance(theta_, bonds_, time_, dt_);  // theta^n -> theta^n+1
+        diffusion_->advance(theta_, bonds_, damageState_.bondAlive(), time_,
+                            dt_);  // theta^n -> theta^n+1
         forcesCurrent_ = false;
     }
     time_ += dt_;
@@ -306,12 +235,15 @@ void Membrane::step() {
 void Membrane::updateDamage() {
     if (!canDamage_) return;
     damage_.resize(particleCount());
+    solver_->reportStrength(damageState_);
+    const std::vector<std::uint8_t>& alive = damageState_.bondAlive();
+    const std::vector<double>& strength = damageState_.strength();
     for (int i = 0; i < particleCount(); ++i) {
         double total = 0.0, intact = 0.0;
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             total += bonds_.weight[b];
-            if (!bonds_.alive[b]) continue;
-            intact += bonds_.weight[b] * solver_->bondStrengthLeft(b);
+            if (!alive[b]) continue;
+            intact += bonds_.weight[b] * strength[b];
         }
         damage_[i] = total > 0.0 ? 1.0 - intact / total : 0.0;
     }
@@ -324,8 +256,7 @@ double Membrane::kineticEnergy() const {
 }
 
 double Membrane::strainEnergy() const {
-    solver_->setTheta(theta_);
-    return solver_->strainEnergy(x_);
+    return solver_->strainEnergy(stepState(), *solver_->makeWorkspace());
 }
 
 double Membrane::maxSpeed() const {
@@ -338,19 +269,12 @@ double Membrane::maxTheta() const {
     return theta_.empty() ? 0.0 : *std::max_element(theta_.begin(), theta_.end());
 }
 
-std::size_t Membrane::brokenBondCount() const {
-    return std::size_t(std::count(bonds_.alive.begin(), bonds_.alive.end(), 0)) / 2;
-}
+std::size_t Membrane::brokenBondCount() const { return damageState_.brokenBondCount(); }
 
 Eigen::Vector3d Membrane::totalMomentum() const {
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (int i = 0; i < particleCount(); ++i) p += mass_[i] * v_[i];
     return p;
-}
-
-Eigen::Matrix3d Membrane::particleStress(int i) const {
-    solver_->setTheta(theta_);
-    return peridynamicBonds().particleStress(i, x_);
 }
 
 FrameView Membrane::view(int frame) const {
@@ -366,8 +290,8 @@ FrameView Membrane::view(int frame) const {
     v.bondOffsets = bonds_.offsets;
     v.bondPartners = bonds_.partners;
     v.bondRestLength = bonds_.restLength;
-    v.bondAlive = bonds_.alive;
-    v.triangleAlive = solver_->triangleAlive();
+    v.bondAlive = damageState_.bondAlive();
+    v.keptTriangles = damageState_.keptTriangles();
     return v;
 }
 

@@ -17,7 +17,9 @@
 #include "sim/BlowUpGuard.h"
 #include "sim/BondLaw.h"
 #include "sim/Bonds.h"
+#include "sim/DamageState.h"
 #include "sim/Diffusion.h"
+#include "sim/Fracture.h"
 #include "sim/FrameView.h"
 #include "sim/Lattice.h"
 #include "sim/Parallel.h"
@@ -27,20 +29,6 @@
 
 namespace rend::sim {
 
-/// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
-/// lattice row store the fracture energy G_f (infinity without one).
-double springCriticalStrain(const MembraneParams& params);
-
-/// Critical strain of the FEM elements and the two-parameter springs, whose cracks take out a
-/// band of elements (triangles) one row high: sqrt(2 (1 - nu^2)) times the springs'.
-double bandCriticalStrain(const MembraneParams& params);
-
-class PeridynamicBonds;
-
-/// The Solver a scene's `solver` names, for the solvers that do not use the Membrane's bonds
-/// (the peridynamic one does; the Membrane builds it).
-std::unique_ptr<Solver> makeSolver(const MembraneParams& params, const Lattice& lattice);
-
 class Membrane {
 public:
     explicit Membrane(const MembraneParams& params);
@@ -48,12 +36,11 @@ public:
     int particleCount() const { return int(x0_.size()); }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }
-    // The peridynamic bonds' constants; these throw std::logic_error for another solver.
-    double micromodulus() const { return law().c; }
-    const BondLaw& law() const;
-    /// eta_c at theta = 0; +infinity when the material has no fracture energy.
-    double criticalStretch() const;
+    /// The scene's solver (its own constants, e.g. PeridynamicBonds::criticalStretch(), are
+    /// reached by a cast).
     const Solver& solver() const { return *solver_; }
+    /// This step's state as the solver sees it.
+    StepState stepState() const { return {x_, v_, theta_, dt_}; }
     bool hasDiffusion() const { return diffusion_.has_value(); }
     const Diffusion* diffusion() const { return diffusion_ ? &*diffusion_ : nullptr; }
     std::size_t notchedBondCount() const { return notched_; }
@@ -88,9 +75,6 @@ public:
     double maxTheta() const;  ///< 0 without diffusion
     std::size_t brokenBondCount() const;
     Eigen::Vector3d totalMomentum() const;
-    /// Virial (Cauchy-like) stress of particle i: 1/(2 V_i) sum_j F_ij (x) r_ij (peridynamic
-    /// bonds only).
-    Eigen::Matrix3d particleStress(int i) const;
     /// The particle whose rest position (x, y) is nearest to `at` (the lowest index on a tie).
     int nearestParticle(const Eigen::Vector2d& at) const;
     /// Number of particles each boundary condition claims (a later one wins an overlap).
@@ -123,6 +107,8 @@ public:
     BondFamilies& bonds() { return bonds_; }
     const BondFamilies& bonds() const { return bonds_; }
     const Lattice& lattice() const { return lattice_; }
+    /// Which bonds are broken and triangles removed (sim/DamageState.h).
+    const DamageState& damageState() const { return damageState_; }
 
 private:
     static constexpr std::int16_t kFree = -1;
@@ -130,11 +116,8 @@ private:
 
     /// Stable step and the blow-up guard from max_i k_i / m_i (Solver::stiffnessRowSums).
     void setStableStep(double worstRatio);
-    /// Breaks both copies of the bond i-j, if there is one (a solver's edge came apart).
-    void breakBond(int i, int j);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
-    const PeridynamicBonds& peridynamicBonds() const;
     void accumulateForces();  ///< the solver's (updating its state) and pressure into force_
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
     void stepSymplecticEuler();
@@ -155,6 +138,7 @@ private:
     MembraneParams params_;
     Lattice lattice_;
     BondFamilies bonds_;
+    DamageState damageState_;  ///< broken bonds, removed triangles: the one owner
     bool canDamage_ = false;
     std::size_t notched_ = 0;
     std::optional<Diffusion> diffusion_;
@@ -164,9 +148,10 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     BlowUpGuard guard_;
-    std::unique_ptr<Solver> solver_;  ///< the internal forces
-    double stiffening_ = 1.0;         ///< the solver's worst tangent stiffness over its rest one
-    long subSteps_ = 0;               ///< extra pieces the power law's stiffening asked for
+    std::unique_ptr<Solver> solver_;        ///< the internal forces
+    std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
+    double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
+    long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     static constexpr int kMaxPieces = 64;
 
     // Structure of arrays: one contiguous array per attribute.
@@ -175,7 +160,6 @@ private:
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
-    std::vector<std::array<int, 3>> pressureEdgeBonds_;  ///< per rest triangle; empty if p = 0
     bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
 };
 

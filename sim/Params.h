@@ -154,21 +154,10 @@ struct TimeParams {
     bool allowUnstable = false;  ///< expert: accept dt above the bound (the guard still runs)
 };
 
-/// Which discretisation turns positions into internal forces (sim/Solver.h). Peridynamic is the
-/// membrane paper's bond model; the others follow the report (seeds/001) and the mass-spring
-/// paper (seeds/003) on the rest lattice's triangles, with a free Poisson ratio; Sph is the
-/// membrane paper's SPH comparison (Sec. 6.1), total-Lagrangian and kernel-corrected.
-enum class SolverKind { Peridynamic, FemCst, MassSpringVanGelder, MassSpringTwoParameter, Sph };
-
-/// The name a scene's `solver` key gives each solver.
-inline const char* solverName(SolverKind kind) {
-    constexpr const char* kNames[] = {"peridynamic", "fem_cst", "mass_spring_vg", "mass_spring_tp",
-                                      "sph"};
-    return kNames[int(kind)];
-}
-
 struct MembraneParams {
-    SolverKind solver = SolverKind::Peridynamic;
+    /// Which discretisation turns positions into internal forces, by its name in the solver
+    /// registry (sim/SolverRegistry.h): "peridynamic" is the membrane paper's bonds.
+    std::string solver = "peridynamic";
     SheetParams sheet;
     MaterialParams material;
     std::vector<BoundaryCondition> boundaries;

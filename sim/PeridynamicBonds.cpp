@@ -8,11 +8,12 @@
 
 #include "sim/Fracture.h"
 #include "sim/Parallel.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 
 PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& lattice,
-                                   BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
+                                   const BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
                                    std::span<const double> volumes)
     : bonds_(bonds),
       rest_(rest),
@@ -21,6 +22,10 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
       horizon_(params.sheet.horizonFactor * params.sheet.dx) {
     computeBondScales(params, lattice.particleArea);
     setUpFracture(params.material);
+}
+
+std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
+    return std::make_unique<PeridynamicBonds>(s.params, s.lattice, s.bonds, s.rest, s.volumes);
 }
 
 void PeridynamicBonds::computeBondScales(const MembraneParams& params, double particleArea) {
@@ -114,39 +119,47 @@ void PeridynamicBonds::setUpFracture(const MaterialParams& m) {
     if (m.law == BondLawKind::Elastoplastic) plastic_.assign(bonds_.directedCount(), {});
 }
 
-double PeridynamicBonds::mechanicalStrain(int i, int b, double length, double& thetaBar) const {
+double PeridynamicBonds::mechanicalStrain(int i, int b, double length,
+                                          std::span<const double> theta, double& thetaBar) const {
     const double eta = length / bonds_.restLength[b] - 1.0;  // eq. 10
-    if (theta_.empty()) {
+    if (theta.empty()) {
         thetaBar = 0.0;
         return eta;
     }
     // The printed eqs. 18-20 use theta_j alone; the mean is symmetric, so the pair forces stay
     // equal and opposite and momentum is conserved.
-    thetaBar = 0.5 * (theta_[i] + theta_[bonds_.partners[b]]);
-    return eta - material_.expansion * thetaBar;
+    thetaBar = 0.5 * (theta[i] + theta[bonds_.partners[b]]);
+    return eta - material_.expansion() * thetaBar;
 }
 
-// Writes only particle i's force and its own copies of its bonds, so the loop needs no atomics.
-// Both copies of a bond see the same strain bit for bit, so they break and yield together.
+// Writes only particle i's force and its own copies of its bonds (plastic state, proposed
+// break), so the loop needs no atomics. Both copies of a bond see the same strain bit for bit,
+// so they break and yield together; a bond past its limit carries nothing already in this
+// step, so breaking after the loop gives the bits of breaking in place.
 template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
-void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
-                                     std::vector<Eigen::Vector3d>& force) {
+void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vector3d>& force,
+                                     Updates& updates) const {
     const int n = bonds_.particleCount();
     force.resize(n);
-    // Raw arrays, loaded once: the stores to `alive` (a char type) and to `plastic` would
+    // Raw arrays, loaded once: the stores to `proposed` (a char type) and to `plastic` would
     // otherwise make the compiler reload every vector's data pointer after each of them.
     const int* offsets = bonds_.offsets.data();
     const int* partners = bonds_.partners.data();
     const double* restLength = bonds_.restLength.data();
     const double* bondScale = bondScale_.data();
-    std::uint8_t* alive = bonds_.alive.data();
-    PlasticState* plastic = plastic_.data();
-    const Eigen::Vector3d* xs = x.data();
-    const double* theta = theta_.data();
-    const Eigen::Vector3d* v = velocities_ ? velocities_->data() : nullptr;
-    const MaterialParams& m = material_;
+    const std::uint8_t* alive = damage_->bondAlive().data();
+    std::uint8_t* proposed = updates.proposed;
+    PlasticState* plastic = updates.plastic;
+    const PlasticState* plasticIn = kUpdateBonds ? plastic : plastic_.data();
+    const Eigen::Vector3d* xs = s.x.data();
+    const double* theta = s.theta.data();
+    const Eigen::Vector3d* v = s.v.data();
+    const double dt = s.dt;
+    const double expansion = material_.expansion();
     double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
-#pragma omp parallel for schedule(static) reduction(min : lowest) if (n >= kParallelThreshold)
+    int breaking = 0;
+#pragma omp parallel for schedule(static) reduction(min : lowest) reduction(+ : breaking) if ( \
+        n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         const Eigen::Vector3d xi = xs[i];
@@ -159,47 +172,48 @@ void PeridynamicBonds::bondForcesFor(const std::vector<Eigen::Vector3d>& x,
             double thetaBar = 0.0;
             if constexpr (kTheta) {  // see mechanicalStrain()
                 thetaBar = 0.5 * (theta[i] + theta[j]);
-                eta -= m.expansion * thetaBar;
+                eta -= expansion * thetaBar;
             }
             if constexpr (kBreak) {  // eq. 27/28
                 double limit = criticalStretch_;
-                if constexpr (kTheta) limit *= degradation(m.strengthLoss, thetaBar);
+                if constexpr (kTheta) limit *= material_.strengthFactor(thetaBar);
                 if (eta > limit) {
-                    if constexpr (kUpdateBonds) alive[b] = 0;
+                    if constexpr (kUpdateBonds) proposed[b] = 1, ++breaking;
                     continue;
                 }
             }
             PlasticState state;
             if constexpr (kLaw == BondLawKind::Elastoplastic) {
-                state = law_.yieldStep(eta, plastic[b]);
+                state = law_.yieldStep(eta, plasticIn[b]);
                 if constexpr (kUpdateBonds) plastic[b] = state;
             }
             if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
                 if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
                     const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
-                    lowest = std::min(lowest, eta + std::min(0.0, dt_ * rate));
+                    lowest = std::min(lowest, eta + std::min(0.0, dt * rate));
                 }
             }
             double f = law_.forceAs<kLaw>(eta, state);
-            if constexpr (kTheta) f *= degradation(m.stiffnessLoss, thetaBar);
+            if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
             sum += (bondScale[b] * f / length) * r;
         }
         force[i] = sum;
     }
-    if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw)
-        stiffening_ = std::max(1.0, law_.powerLawStiffening(std::max(lowest, -0.95)));
+    updates.breaking = breaking;
+    updates.lowest = lowest;
 }
 
 template <bool kUpdateBonds>
-void PeridynamicBonds::bondForces(const std::vector<Eigen::Vector3d>& x,
-                                  std::vector<Eigen::Vector3d>& force) {
-    const bool theta = !theta_.empty();
+void PeridynamicBonds::bondForces(const StepState& s, std::vector<Eigen::Vector3d>& force,
+                                  Updates& updates) const {
+    const bool theta = !s.theta.empty();
     const bool breakable = std::isfinite(criticalStretch_);
     auto forLaw = [&]<BondLawKind kLaw>() {
-        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(x, force);
-        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(x, force);
-        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(x, force);
-        if (!theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, false, false>(x, force);
+        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(s, force, updates);
+        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(s, force, updates);
+        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(s, force, updates);
+        if (!theta && !breakable)
+            bondForcesFor<kUpdateBonds, kLaw, false, false>(s, force, updates);
     };
     switch (law_.kind) {
         case BondLawKind::Linear:
@@ -211,49 +225,54 @@ void PeridynamicBonds::bondForces(const std::vector<Eigen::Vector3d>& x,
     }
 }
 
-void PeridynamicBonds::forces(const std::vector<Eigen::Vector3d>& x,
+void PeridynamicBonds::forces(const StepState& s, Workspace&,
                               std::vector<Eigen::Vector3d>& force) const {
-    // With kUpdateBonds = false the loop writes nothing but `force`.
-    const_cast<PeridynamicBonds*>(this)->bondForces<false>(x, force);
+    Updates none;
+    bondForces<false>(s, force, none);
 }
 
-std::vector<std::array<int, 2>> PeridynamicBonds::advance(const std::vector<Eigen::Vector3d>& x,
-                                                          const std::vector<Eigen::Vector3d>& v,
-                                                          double dt,
-                                                          std::vector<Eigen::Vector3d>& force) {
-    velocities_ = &v;
-    dt_ = dt;
-    bondForces<true>(x, force);
-    return {};  // the shared bonds broke in place
+void PeridynamicBonds::advance(const StepState& s, Workspace&,
+                               std::vector<Eigen::Vector3d>& force) {
+    Updates updates{plastic_.data(), damage_->proposals()};
+    bondForces<true>(s, force, updates);
+    if (updates.breaking > 0) damage_->applyProposals();
+    if (law_.kind == BondLawKind::PowerLaw)
+        stiffening_ = std::max(1.0, law_.powerLawStiffening(clampCompression(updates.lowest)));
 }
 
-double PeridynamicBonds::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+void PeridynamicBonds::reportStrength(DamageState& damage) const {
+    for (std::size_t b = 0; b < plastic_.size(); ++b)
+        damage.weaken(int(b), law_.strengthLeft(plastic_[b]));  // eq. 27
+}
+
+double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
+    const auto& x = s.x;
     double sum = 0.0;
     for (int i = 0; i < bonds_.particleCount(); ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-            if (!bonds_.alive[b]) continue;
+            if (!damage_->bondAlive()[b]) continue;
             double thetaBar;
             const double length = (x[bonds_.partners[b]] - x[i]).norm();
-            const double eta = mechanicalStrain(i, b, length, thetaBar);
+            const double eta = mechanicalStrain(i, b, length, s.theta, thetaBar);
             const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
             // Each bond is stored from both ends: half of U_ij from each.
             sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
-                   degradation(material_.stiffnessLoss, thetaBar) * law_.energy(eta, state);
+                   material_.stiffnessFactor(thetaBar) * law_.energy(eta, state);
         }
     return sum;
 }
 
-Eigen::Matrix3d PeridynamicBonds::particleStress(int i,
-                                                 const std::vector<Eigen::Vector3d>& x) const {
+Eigen::Matrix3d PeridynamicBonds::particleStress(int i, const StepState& s) const {
+    const auto& x = s.x;
     Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
     for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
-        if (!bonds_.alive[b]) continue;
+        if (!damage_->bondAlive()[b]) continue;
         const Eigen::Vector3d r = x[bonds_.partners[b]] - x[i];
         const double length = r.norm();
         double thetaBar;
-        const double eta = mechanicalStrain(i, b, length, thetaBar);
+        const double eta = mechanicalStrain(i, b, length, s.theta, thetaBar);
         const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
-        const double f = degradation(material_.stiffnessLoss, thetaBar) * law_.force(eta, state);
+        const double f = material_.stiffnessFactor(thetaBar) * law_.force(eta, state);
         sigma += (bondScale_[b] * f / length) * r * r.transpose();
     }
     return sigma / (2.0 * volume_[i]);

@@ -2,7 +2,14 @@
 // The internal forces of one membrane discretisation. Membrane owns what every solver shares:
 // the particles and their lumped masses, the rest lattice and its triangles, boundary
 // conditions, gravity, damping, the follower pressure, the integrators with their stable step,
-// the blow-up guard, diffusion and the FrameView. A Solver only turns positions into forces.
+// the blow-up guard, diffusion, the DamageState and the FrameView. A Solver only turns a step's
+// state into forces, and breaks through the DamageState's operations.
+//
+// The contract: everything a step depends on arrives in the StepState; forces() and
+// strainEnergy() are const and write only their Workspace (the solver's scratch, made by
+// makeWorkspace()) and the forces; advance() alone moves the solver's history on (yield,
+// fracture through the DamageState). Solvers are listed, with what they support, in
+// sim/SolverRegistry.h.
 //
 // Implemented by the peridynamic bonds of the membrane paper (PeridynamicBonds) and by the
 // continuum, spring and SPH models of the other papers.
@@ -10,18 +17,44 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "sim/Bonds.h"
+#include "sim/DamageState.h"
+
 namespace rend::sim {
+
+struct SolverSetUp;  // sim/SolverRegistry.h: what a solver's factory builds it from
+
+/// One step's state, passed explicitly.
+struct StepState {
+    std::span<const Eigen::Vector3d> x;  ///< positions
+    std::span<const Eigen::Vector3d> v;  ///< velocities; empty where only forces are asked
+    std::span<const double> theta;       ///< the diffusing quantity; empty without diffusion
+    double dt = 0.0;                     ///< the step about to be taken [s]
+};
+
+/// A solver's scratch for one force evaluation (per-element or per-spring intermediates). Each
+/// solver derives its own and makes it with Solver::makeWorkspace().
+class Workspace {
+public:
+    virtual ~Workspace() = default;
+};
 
 class Solver {
 public:
     virtual ~Solver() = default;
 
-    /// Internal force on every particle at positions x, overwriting `force` (sized by the
-    /// caller). The sum over particles is zero: forces are internal.
-    virtual void forces(const std::vector<Eigen::Vector3d>& x,
+    /// The scratch forces(), strainEnergy() and advance() need; a plain Workspace by default.
+    virtual std::unique_ptr<Workspace> makeWorkspace() const {
+        return std::make_unique<Workspace>();
+    }
+
+    /// Internal force on every particle at s.x, overwriting `force` (resized to the particles).
+    /// The sum over particles is zero: forces are internal. Changes no state.
+    virtual void forces(const StepState& s, Workspace& work,
                         std::vector<Eigen::Vector3d>& force) const = 0;
 
     /// Per particle, half the absolute row sum of the rest stiffness matrix [N/m] (for springs,
@@ -29,56 +62,84 @@ public:
     /// for dt <= sqrt(2 m_i / k_i), the same bound as the peridynamic bonds'.
     virtual std::vector<double> stiffnessRowSums(int particleCount) const = 0;
 
-    /// Stored elastic energy at positions x [J].
-    virtual double strainEnergy(const std::vector<Eigen::Vector3d>& x) const = 0;
+    /// Stored elastic energy at s.x [J].
+    virtual double strainEnergy(const StepState& s, Workspace& work) const = 0;
 
-    /// Breaks, for good, whatever is past its critical strain at x, and returns the rest
-    /// lattice's edges {i, j} that came apart in this call, so Membrane can break the matching
-    /// bonds (the FrameView, damage and diffusion read those). Nothing breaks by default.
-    virtual std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) {
-        return {};
-    }
+    /// Breaks, for good, whatever is past its critical strain at s.x (through the
+    /// DamageState's operations), and yields whatever yields. Nothing by default.
+    virtual void fracture(const StepState& s, Workspace& work) {}
 
-    /// One step's forces at x that also move the solver's history on: whatever is past its
-    /// critical strain breaks, whatever yields yields. Returns the rest edges that came apart, as
-    /// fracture() does. `v` and `dt` let a law that stiffens (the power law in compression) look
-    /// ahead for stiffening(). By default fracture() then forces().
-    virtual std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                                    const std::vector<Eigen::Vector3d>& v,
-                                                    double dt,
-                                                    std::vector<Eigen::Vector3d>& force) {
-        std::vector<std::array<int, 2>> apart = fracture(x);
-        forces(x, force);
-        return apart;
+    /// One step's forces at s.x that also move the solver's history on, as fracture() then
+    /// forces(). A law that stiffens (the power law in compression) looks ahead by s.v and
+    /// s.dt for stiffening().
+    virtual void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) {
+        fracture(s, work);
+        forces(s, work, force);
     }
 
     /// The worst tangent stiffness over its rest value (>= 1) seen by the last advance(): the
     /// explicit step is cut into pieces so each stays within the rest bound over its square root.
     virtual double stiffening() const { return 1.0; }
 
-    /// Fraction of strength (eq. 27's gamma) the shared bond b of the Membrane's BondFamilies
-    /// still has, for the damage field; 1 unless the solver keeps it per bond.
-    virtual double bondStrengthLeft(int bond) const { return 1.0; }
+    /// Writes into the DamageState, with weaken(), eq. 27's gamma of every bond whose strength
+    /// the solver keeps in its own pieces (springs, elements); called once per frame, for the
+    /// damage field. Nothing by default: every bond keeps full strength.
+    virtual void reportStrength(DamageState& damage) const {}
 
-    /// The Membrane's bond families in CSR (bonds of particle i: [offsets[i], offsets[i+1]),
-    /// partner j), given once after construction, for a solver whose bondStrengthLeft() must
-    /// map a bond onto its own pieces. Ignored by default.
-    virtual void bindBonds(std::span<const int> offsets, std::span<const int> partners) {}
+    /// Set-up, before anything else: the Membrane's bonds and the DamageState the solver reads
+    /// in forces() and changes in advance(); both outlive the solver.
+    void bind(const BondFamilies& bonds, DamageState& damage) {
+        sharedBonds_ = &bonds;
+        damage_ = &damage;
+        onBind();
+        own_.reset();
+    }
 
-    /// Cuts the edges {i, j} at set-up (pre-notches). Returns false when the solver cannot
-    /// represent a cut.
-    virtual bool cut(const std::vector<std::array<int, 2>>& edges) { return edges.empty(); }
+    /// Carries the notches into the solver's own pieces at set-up: the DamageState already has
+    /// the bonds {i, j} in `edges` broken (and their edges).
+    virtual void cut(const std::vector<std::array<int, 2>>& edges) {}
 
-    /// Per rest triangle, 1 while it carries load and 0 once removed; empty when the solver
-    /// removes none.
-    virtual std::span<const std::uint8_t> triangleAlive() const { return {}; }
-
-    /// The diffusing quantity per particle (empty without diffusion), for the solvers that
-    /// couple to it; Membrane sets it before every forces() and fracture().
-    void setTheta(std::span<const double> theta) { theta_ = theta; }
+    // Conveniences for tests and tools: one call at x (theta none) with a fresh workspace.
+    std::vector<Eigen::Vector3d> forcesAt(std::span<const Eigen::Vector3d> x) const {
+        std::vector<Eigen::Vector3d> force;
+        forces({x}, *makeWorkspace(), force);
+        return force;
+    }
+    double energyAt(std::span<const Eigen::Vector3d> x) const {
+        return strainEnergy({x}, *makeWorkspace());
+    }
+    void fractureAt(std::span<const Eigen::Vector3d> x) { fracture({x}, *makeWorkspace()); }
+    std::vector<Eigen::Vector3d> advanceAt(std::span<const Eigen::Vector3d> x,
+                                           std::span<const Eigen::Vector3d> v, double dt) {
+        std::vector<Eigen::Vector3d> force;
+        advance({x, v, {}, dt}, *makeWorkspace(), force);
+        return force;
+    }
 
 protected:
-    std::span<const double> theta_;
+    /// What the solver derives from the bound bonds and damage maps.
+    virtual void onBind() {}
+
+    /// A solver built on its own (tests, benches) works on a fresh state of its own over
+    /// `bonds` (empty: none) and `triangles` until a Membrane binds its shared one.
+    void bindOwn(BondFamilies bonds, int particleCount,
+                 std::span<const std::array<int, 3>> triangles) {
+        if (bonds.offsets.empty()) bonds.offsets.assign(particleCount + 1, 0);
+        auto own = std::make_unique<Own>(Own{std::move(bonds), {}});
+        own->damage = DamageState(own->bonds, triangles);
+        bind(own->bonds, own->damage);
+        own_ = std::move(own);
+    }
+
+    const BondFamilies* sharedBonds_ = nullptr;
+    DamageState* damage_ = nullptr;
+
+private:
+    struct Own {
+        BondFamilies bonds;
+        DamageState damage;
+    };
+    std::unique_ptr<Own> own_;
 };
 
 }  // namespace rend::sim

@@ -7,6 +7,7 @@
 
 #include "sim/Fracture.h"
 #include "sim/Parallel.h"
+#include "sim/SolverRegistry.h"
 
 namespace rend::sim {
 namespace {
@@ -36,23 +37,21 @@ double sphCriticalStrain(double fractureEnergy, double youngsModulus, double dx)
     return std::sqrt(1.0 + 2.0 * green) - 1.0;
 }
 
-TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
-                                       const MaterialParams& material, double thickness,
-                                       std::span<const Notch> notches, double criticalStrain)
+TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx, const Material& material,
+                                       double thickness, std::span<const Notch> notches,
+                                       double criticalStrain)
     : rest_(lattice.positions),
       support_(kSupport * dx),
-      expansion_(material.expansion),
-      stiffnessLoss_(material.stiffnessLoss),
-      strengthLoss_(material.strengthLoss),
+      material_(material),
+      expansion_(material.expansion()),
       thickness_(thickness),
       criticalStrain_(criticalStrain) {
-    const double nu = material.poissonRatio;
-    if (!(nu > -1.0 && nu < 0.5)) throw std::invalid_argument("sph needs -1 < poisson < 0.5");
-    lambda_ = material.youngsModulus * nu / (1.0 - nu * nu);
-    mu_ = material.youngsModulus / (2.0 * (1.0 + nu));
+    lambda_ = material.lambda();
+    mu_ = material.mu();
     const int n = int(rest_.size());
     pairs_ = buildBondFamilies(rest_, support_);
-    applyNotches(notches, rest_, pairs_);
+    pairAlive_.assign(pairs_.directedCount(), 1);
+    for (const int k : notchedBonds(notches, rest_, pairs_)) pairAlive_[k] = 0;
     offsets_ = pairs_.offsets;
     neighbours_ = pairs_.partners;
     volume_.assign(n, lattice.particleArea);
@@ -63,35 +62,47 @@ TotalLagrangianSph::TotalLagrangianSph(const Lattice& lattice, double dx,
     for (int i = 0; i < n; ++i)
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             mirror_[k] = findBond(pairs_, neighbours_[k], i);
-    stress_.resize(n);
     restMetric_.assign(n, -1);
     breaking_.assign(neighbours_.size(), 0);
-    // The pairs that are also sides of rest triangles: their breaking is reported to Membrane
-    // (the FrameView's cracks) and removes the triangles on either side.
-    latticeEdge_.assign(neighbours_.size(), 0);
-    triangleSidePairs_.reserve(lattice.triangles.size());
-    for (const auto& t : lattice.triangles) {
-        std::array<int, 3> side{};
-        for (int s = 0; s < 3; ++s) {
-            const int a = t[(s + 1) % 3], b = t[(s + 2) % 3];
-            side[s] = findBond(pairs_, a, b);
-            if (side[s] >= 0) latticeEdge_[side[s]] = latticeEdge_[mirror_[side[s]]] = 1;
-        }
-        triangleSidePairs_.push_back(side);
-    }
-    if (std::isfinite(criticalStrain_)) triangleAlive_.assign(lattice.triangles.size(), 1);
+    bindOwn({}, n, lattice.triangles);
+}
+
+std::unique_ptr<Solver> TotalLagrangianSph::make(const SolverSetUp& s) {
+    if (s.params.sheet.outline == Outline::Sphere)
+        throw std::invalid_argument("the sph solver needs a flat rest sheet");
+    const MaterialParams& m = s.params.material;
+    return std::make_unique<TotalLagrangianSph>(
+        s.lattice, s.params.sheet.dx, s.material, s.params.sheet.thickness, s.params.notches,
+        m.fractureEnergy ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, s.params.sheet.dx)
+                         : std::numeric_limits<double>::infinity());
+}
+
+void TotalLagrangianSph::onBind() {
+    // The pairs that are also sides of rest triangles (the FrameView's cracks); set-up only.
+    pairEdge_.assign(neighbours_.size(), -1);
+    const auto& edges = damage_->edges();
+    for (int e = 0; e < int(edges.size()); ++e)
+        if (const int k = findBond(pairs_, edges[e][0], edges[e][1]); k >= 0)
+            pairEdge_[k] = pairEdge_[mirror_[k]] = e;
 }
 
 bool TotalLagrangianSph::pairAlive(int i, int j) const {
     const int k = findBond(pairs_, i, j);
-    return k >= 0 && pairs_.alive[k];
+    return k >= 0 && pairAlive_[k];
 }
 
-std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
-    const std::vector<Eigen::Vector3d>& x) {
-    if (!std::isfinite(criticalStrain_)) return {};
+std::unique_ptr<Workspace> TotalLagrangianSph::makeWorkspace() const {
+    return std::make_unique<SphWorkspace>();
+}
+
+void TotalLagrangianSph::fracture(const StepState& s, Workspace& work) {
+    if (!std::isfinite(criticalStrain_)) return;
+    const auto& x = s.x;
+    const auto& theta = s.theta;
     const int n = int(x.size());
-    deformations(x);
+    std::vector<Eigen::Matrix<double, 3, 2>>& deformation =
+        static_cast<SphWorkspace&>(work).deformation;
+    deformations(s, deformation);
     // The pair's stretch seen through the mean of its ends' mechanical F, not its own length:
     // F filters the particle-scale (zero-energy) noise that the pair lengths carry, twice the
     // continuum's strain next to the grips (see the top). Both copies of a pair see the same
@@ -99,51 +110,47 @@ std::vector<std::array<int, 2>> TotalLagrangianSph::fracture(
     int count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
-        const double si = 1.0 + expansion_ * thetaAt(i);
+        const double si = 1.0 + expansion_ * thetaAt(theta, i);
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             breaking_[k] = 0;
-            if (!pairs_.alive[k]) continue;
+            if (!pairAlive_[k]) continue;
             const int j = neighbours_[k];
-            const double thetaBar = 0.5 * (thetaAt(i) + thetaAt(j));
+            const double thetaBar = 0.5 * (thetaAt(theta, i) + thetaAt(theta, j));
             const Eigen::Vector2d d = (rest_[j] - rest_[i]).head<2>() / pairs_.restLength[k];
-            const double sj = 1.0 + expansion_ * thetaAt(j);
-            const double eta =
-                (0.5 * (deformation_[i] / si + deformation_[j] / sj) * d).norm() - 1.0;
-            const double limit = criticalStrain_ * std::max(0.0, 1.0 - strengthLoss_ * thetaBar);
+            const double sj = 1.0 + expansion_ * thetaAt(theta, j);
+            const double eta = (0.5 * (deformation[i] / si + deformation[j] / sj) * d).norm() - 1.0;
+            const double limit = criticalStrain_ * material_.strengthFactor(thetaBar);
             const double length = (x[j] - x[i]).norm() / pairs_.restLength[k];
             breaking_[k] = eta > limit || length > kTetherStretch;
             count += breaking_[k];
         }
     }
-    std::vector<std::array<int, 2>> apart;
-    if (count == 0) return apart;
+    if (count == 0) return;
     std::vector<int> touched;
     for (int i = 0; i < n; ++i)
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             if (breaking_[k]) {
                 breakPair(k, touched);
-                if (latticeEdge_[k] && i < neighbours_[k]) apart.push_back({i, neighbours_[k]});
+                if (pairEdge_[k] >= 0) damage_->breakEdge(pairEdge_[k]);  // in index order
             }
     settle(touched);
-    for (int i : touched) deformation_[i] = deformationGradient(i, x);
-    return apart;
+    for (int i : touched) deformation[i] = deformationGradient(i, x);
 }
 
-bool TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
+void TotalLagrangianSph::cut(const std::vector<std::array<int, 2>>& edges) {
     // Without fracture the notches did it all at set-up, with their pairs re-corrected.
-    if (!std::isfinite(criticalStrain_)) return true;
+    if (!std::isfinite(criticalStrain_)) return;
     std::vector<int> touched;
     for (const auto& [i, j] : edges)
-        if (const int k = findBond(pairs_, i, j); k >= 0 && pairs_.alive[k]) {
+        if (const int k = findBond(pairs_, i, j); k >= 0 && pairAlive_[k]) {
             breakPair(k, touched);
             breakPair(mirror_[k], touched);
         }
     settle(touched);
-    return true;
 }
 
 void TotalLagrangianSph::breakPair(int k, std::vector<int>& touched) {
-    pairs_.alive[k] = 0;
+    pairAlive_[k] = 0;
     gradient_[k].setZero();
     const int i = int(std::upper_bound(offsets_.begin(), offsets_.end(), k) - offsets_.begin()) - 1;
     touched.push_back(i);
@@ -165,29 +172,21 @@ void TotalLagrangianSph::settle(std::vector<int>& touched) {
         }
         metric_[restMetric_[i]] = B.transpose() * B;
     }
-    for (std::size_t t = 0; t < triangleSidePairs_.size(); ++t)
-        for (int k : triangleSidePairs_[t])
-            if (k >= 0 && !pairs_.alive[k]) triangleAlive_[t] = 0;
 }
 
-std::vector<std::array<int, 2>> TotalLagrangianSph::advance(const std::vector<Eigen::Vector3d>& x,
-                                                            const std::vector<Eigen::Vector3d>&,
-                                                            double,
-                                                            std::vector<Eigen::Vector3d>& force) {
-    if (!std::isfinite(criticalStrain_)) {
-        forces(x, force);
-        return {};
-    }
-    std::vector<std::array<int, 2>> apart = fracture(x);  // leaves deformation_ at x
-    forcesFrom(force);
-    return apart;
+void TotalLagrangianSph::advance(const StepState& s, Workspace& work,
+                                 std::vector<Eigen::Vector3d>& force) {
+    if (!std::isfinite(criticalStrain_)) return forces(s, work, force);
+    fracture(s, work);  // leaves the deformation gradients at s.x in the workspace
+    forcesFrom(s, static_cast<SphWorkspace&>(work), force);
 }
 
-void TotalLagrangianSph::deformations(const std::vector<Eigen::Vector3d>& x) const {
-    const int n = int(x.size());
-    deformation_.resize(n);
+void TotalLagrangianSph::deformations(const StepState& s,
+                                      std::vector<Eigen::Matrix<double, 3, 2>>& deformation) const {
+    const int n = int(s.x.size());
+    deformation.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) deformation_[i] = deformationGradient(i, x);
+    for (int i = 0; i < n; ++i) deformation[i] = deformationGradient(i, s.x);
 }
 
 void TotalLagrangianSph::correctGradients(int i) {
@@ -195,7 +194,7 @@ void TotalLagrangianSph::correctGradients(int i) {
     for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
         const Eigen::Vector2d d = (rest_[neighbours_[k]] - rest_[i]).head<2>();
         gradient_[k] =
-            pairs_.alive[k]
+            pairAlive_[k]
                 ? Eigen::Vector2d(volume_[neighbours_[k]] * kernel(d.norm(), support_) * d)
                 : Eigen::Vector2d::Zero();
         A += d * gradient_[k].transpose();
@@ -208,7 +207,7 @@ void TotalLagrangianSph::correctGradients(int i) {
 }
 
 Eigen::Matrix<double, 3, 2> TotalLagrangianSph::deformationGradient(
-    int i, const std::vector<Eigen::Vector3d>& x) const {
+    int i, std::span<const Eigen::Vector3d> x) const {
     Eigen::Matrix<double, 3, 2> F = Eigen::Matrix<double, 3, 2>::Zero();
     for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
         F += (x[neighbours_[k]] - x[i]) * gradient_[k].transpose();
@@ -226,20 +225,26 @@ Eigen::Matrix<double, 3, 2> TotalLagrangianSph::firstPiola(
     return F * (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
 }
 
-void TotalLagrangianSph::forces(const std::vector<Eigen::Vector3d>& x,
+void TotalLagrangianSph::forces(const StepState& s, Workspace& work,
                                 std::vector<Eigen::Vector3d>& force) const {
-    deformations(x);
-    forcesFrom(force);
+    SphWorkspace& sph = static_cast<SphWorkspace&>(work);
+    deformations(s, sph.deformation);
+    forcesFrom(s, sph, force);
 }
 
-void TotalLagrangianSph::forcesFrom(std::vector<Eigen::Vector3d>& force) const {
-    const int n = int(deformation_.size());
+void TotalLagrangianSph::forcesFrom(const StepState& s, SphWorkspace& work,
+                                    std::vector<Eigen::Vector3d>& force) const {
+    const std::vector<Eigen::Matrix<double, 3, 2>>& deformation = work.deformation;
+    std::vector<Eigen::Matrix<double, 3, 2>>& stress = work.stress;
+    const int n = int(deformation.size());
+    stress.resize(n);
+    force.resize(n);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
-        const double stretch = 1.0 + expansion_ * thetaAt(i);
-        stress_[i] = volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) /
-                     stretch * firstPiola(i, deformation_[i] / stretch);
+        const double stretch = 1.0 + expansion_ * thetaAt(s.theta, i);
+        stress[i] = volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) /
+                    stretch * firstPiola(i, deformation[i] / stretch);
     }
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
@@ -247,9 +252,9 @@ void TotalLagrangianSph::forcesFrom(std::vector<Eigen::Vector3d>& force) const {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
             own += gradient_[k];
-            sum -= stress_[neighbours_[k]] * gradient_[mirror_[k]];  // - V_j h P_j g_ji
+            sum -= stress[neighbours_[k]] * gradient_[mirror_[k]];  // - V_j h P_j g_ji
         }
-        force[i] = sum + stress_[i] * own;
+        force[i] = sum + stress[i] * own;
     }
 }
 
@@ -274,13 +279,14 @@ std::vector<double> TotalLagrangianSph::stiffnessRowSums(int particleCount) cons
     return sums;
 }
 
-double TotalLagrangianSph::strainEnergy(const std::vector<Eigen::Vector3d>& x) const {
+double TotalLagrangianSph::strainEnergy(const StepState& s, Workspace&) const {
+    const auto& x = s.x;
     double sum = 0.0;
     for (int i = 0; i < int(x.size()); ++i) {
         const Eigen::Matrix<double, 3, 2> F =
-            deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(i));
+            deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(s.theta, i));
         const Eigen::Matrix2d E = greenStrain(i, F);
-        sum += volume_[i] * thickness_ * std::max(0.0, 1.0 - stiffnessLoss_ * thetaAt(i)) *
+        sum += volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }
     return sum;

@@ -27,7 +27,7 @@
 // pairs of d_ij g_ij^T: E = (F^T F - C0) / 2, so the rest state and rigid motions stay stress-free,
 // the stiffness across the crack fades with the pairs, no gradient grows, and a particle with no
 // pair left carries no stress. Forces stay the exact gradient. Pairs that are rest-lattice edges
-// are reported to Membrane and kill their triangles.
+// break their edge in the DamageState, which drops the triangles on either side.
 //
 // Why F and not the pair's own length: in crack_path_sources at dx = 0.04 (no fracture, 0.4 s)
 // the longest pair stretch next to the grips is 0.051 and 0.043 inside (FEM: 0.039 and 0.019),
@@ -39,11 +39,13 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "sim/Bonds.h"
 #include "sim/Lattice.h"
+#include "sim/Material.h"
 #include "sim/Params.h"
 #include "sim/Solver.h"
 
@@ -57,22 +59,22 @@ double sphCriticalStrain(double fractureEnergy, double youngsModulus, double dx)
 
 class TotalLagrangianSph final : public Solver {
 public:
-    TotalLagrangianSph(const Lattice& lattice, double dx, const MaterialParams& material,
+    TotalLagrangianSph(const Lattice& lattice, double dx, const Material& material,
                        double thickness, std::span<const Notch> notches,
                        double criticalStrain = std::numeric_limits<double>::infinity());
+    /// The registry's factory; throws std::invalid_argument for a curved (sphere) rest sheet.
+    static std::unique_ptr<Solver> make(const SolverSetUp& s);
 
-    void forces(const std::vector<Eigen::Vector3d>& x,
+    std::unique_ptr<Workspace> makeWorkspace() const override;
+    void forces(const StepState& s, Workspace& work,
                 std::vector<Eigen::Vector3d>& force) const override;
     std::vector<double> stiffnessRowSums(int particleCount) const override;
-    double strainEnergy(const std::vector<Eigen::Vector3d>& x) const override;
+    double strainEnergy(const StepState& s, Workspace& work) const override;
     /// Breaks the pairs {i, j} as fracture would (the notches' own were removed at set-up).
-    bool cut(const std::vector<std::array<int, 2>>& edges) override;
-    std::vector<std::array<int, 2>> fracture(const std::vector<Eigen::Vector3d>& x) override;
+    void cut(const std::vector<std::array<int, 2>>& edges) override;
+    void fracture(const StepState& s, Workspace& work) override;
     /// fracture() then the forces from the same deformation gradients.
-    std::vector<std::array<int, 2>> advance(const std::vector<Eigen::Vector3d>& x,
-                                            const std::vector<Eigen::Vector3d>& v, double dt,
-                                            std::vector<Eigen::Vector3d>& force) override;
-    std::span<const std::uint8_t> triangleAlive() const override { return triangleAlive_; }
+    void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
 
     /// Pairs broken by fracture so far (each counted once; notches not included).
     std::size_t brokenPairCount() const { return brokenPairs_; }
@@ -81,47 +83,55 @@ public:
 
     /// F_i at positions x.
     Eigen::Matrix<double, 3, 2> deformationGradient(int i,
-                                                    const std::vector<Eigen::Vector3d>& x) const;
+                                                    std::span<const Eigen::Vector3d> x) const;
 
 private:
     Eigen::Matrix<double, 3, 2> firstPiola(int i, const Eigen::Matrix<double, 3, 2>& F) const;
     /// Green strain of particle i against its rest metric (the identity until a pair breaks).
     Eigen::Matrix2d greenStrain(int i, const Eigen::Matrix<double, 3, 2>& F) const;
-    /// F_i of every particle at x into deformation_.
-    void deformations(const std::vector<Eigen::Vector3d>& x) const;
-    /// Forces from deformation_.
-    void forcesFrom(std::vector<Eigen::Vector3d>& force) const;
+    /// The forces' scratch: F_i at the last x and V_i h P_i, per particle.
+    struct SphWorkspace : Workspace {
+        std::vector<Eigen::Matrix<double, 3, 2>> deformation, stress;
+    };
+    /// F_i of every particle at s.x.
+    void deformations(const StepState& s,
+                      std::vector<Eigen::Matrix<double, 3, 2>>& deformation) const;
+    /// Forces from the workspace's deformation gradients.
+    void forcesFrom(const StepState& s, SphWorkspace& work,
+                    std::vector<Eigen::Vector3d>& force) const;
     /// Drops the pair copy k's gradient; its particle goes into `touched`.
     void breakPair(int k, std::vector<int>& touched);
-    /// Rest metrics of the touched particles and the triangles that lost a side.
+    /// Rest metrics of the touched particles.
     void settle(std::vector<int>& touched);
+    /// The pairs along rest-lattice edges, whose breaking breaks the DamageState's edge.
+    void onBind() override;
     /// Corrected gradients of particle i over its living pairs; none when they no longer span
     /// the plane (the particle has broken loose and carries no stress).
     void correctGradients(int i);
-    double thetaAt(int i) const { return theta_.empty() ? 0.0 : theta_[i]; }
+    static double thetaAt(std::span<const double> theta, int i) {
+        return theta.empty() ? 0.0 : theta[i];
+    }
 
     // CSR neighbours of each particle with their corrected gradients g_ij; `mirror[k]` is the
     // index of the pair j -> i in j's list.
-    BondFamilies pairs_;  ///< rest neighbours within 2 dx, with alive flags
+    BondFamilies pairs_;                   ///< rest neighbours within 2 dx
+    std::vector<std::uint8_t> pairAlive_;  ///< per pair copy: 1 whole, 0 broken
     std::vector<int> offsets_, neighbours_, mirror_;
     std::vector<Eigen::Vector3d> rest_;
     double support_ = 0.0;
-    double expansion_ = 0.0, stiffnessLoss_ = 0.0, strengthLoss_ = 0.0;
+    Material material_;
+    double expansion_ = 0.0;
     std::vector<Eigen::Vector2d> gradient_;
     std::vector<double> volume_;
     double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0;
-    mutable std::vector<Eigen::Matrix<double, 3, 2>> stress_;  ///< V_i h P_i per particle
 
     // Fracture: a pair past the critical strain loses its gradient; the particle keeps its rest
     // correction and measures strain against its rest metric C0_i = B_i^T B_i (see the top).
     double criticalStrain_;
     std::vector<std::int32_t> restMetric_;  ///< index into metric_ per particle, -1 undamaged
     std::vector<Eigen::Matrix2d> metric_;   ///< C0 of the damaged particles
-    mutable std::vector<Eigen::Matrix<double, 3, 2>> deformation_;  ///< F_i at the last x
-    std::vector<std::uint8_t> breaking_;     ///< per pair copy, set by this step's check
-    std::vector<std::uint8_t> latticeEdge_;  ///< per pair copy: also a rest-lattice edge
-    std::vector<std::array<int, 3>> triangleSidePairs_;
-    std::vector<std::uint8_t> triangleAlive_;
+    std::vector<std::uint8_t> breaking_;    ///< per pair copy, set by this step's check
+    std::vector<int> pairEdge_;  ///< per pair copy: the DamageState's edge along it, or -1
     std::size_t brokenPairs_ = 0;
 };
 

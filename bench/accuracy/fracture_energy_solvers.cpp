@@ -22,7 +22,7 @@ struct ReleasePoint {
     double ratio, window;
 };
 
-ReleasePoint releaseRun(sim::SolverKind solver, double safety, double scale) {
+ReleasePoint releaseRun(std::string solver, double safety, double scale) {
     const auto start = Clock::now();
     checks::NotchedStrip s;
     s.solver = solver;
@@ -45,23 +45,20 @@ std::string tableRow(const std::string& label, double safety, const ReleasePoint
 }
 
 void fractureEnergySolversCase(Report& report) {
-    using sim::SolverKind;
     report.line("# solver              dt  G/G_f   window  onset/Gr  broken   off  grips  seconds");
     const double safeties[] = {0.8, 0.4, 0.2};
-    for (SolverKind solver :
-         {SolverKind::Peridynamic, SolverKind::FemCst, SolverKind::MassSpringVanGelder,
-          SolverKind::MassSpringTwoParameter, SolverKind::Sph}) {
-        Family f{
-            "fracture_energy_solvers", std::string(sim::solverName(solver)) + " dt sweep", {}, ""};
+    for (std::string solver :
+         {"peridynamic", "fem_cst", "mass_spring_vg", "mass_spring_tp", "sph"}) {
+        Family f{"fracture_energy_solvers", std::string(solver.c_str()) + " dt sweep", {}, ""};
         std::string measured;
         // SPH gives no single crack at any dt and takes 40 s at 0.2 x the bound.
-        const int count = solver == SolverKind::Sph ? 1 : 3;
+        const int count = solver == "sph" ? 1 : 3;
         for (int k = 0; k < count; ++k) {
             const ReleasePoint p = releaseRun(solver, safeties[k], 1.0);
             f.points.push_back(
                 {"dt=" + fmt("%.1f", safeties[k]), p.seconds, std::abs(p.ratio - 1.0)});
             report.row(f, f.points.back());
-            report.line(tableRow(sim::solverName(solver), safeties[k], p));
+            report.line(tableRow(solver.c_str(), safeties[k], p));
             measured += (measured.empty() ? "" : ", ") + fmt("%.4f", p.ratio);
         }
         f.why =

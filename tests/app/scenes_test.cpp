@@ -39,7 +39,7 @@ std::vector<Eigen::Vector2d> brokenBondMidpoints(const sim::Membrane& m) {
     const sim::BondFamilies& b = m.bonds();
     for (int i = 0; i < m.particleCount(); ++i)
         for (int k = b.offsets[i]; k < b.offsets[i + 1]; ++k)
-            if (!b.alive[k] && i < b.partners[k])
+            if (!m.damageState().bondAlive()[k] && i < b.partners[k])
                 points.push_back(
                     0.5 * (m.restPositions()[i] + m.restPositions()[b.partners[k]]).head<2>());
     return points;

@@ -33,6 +33,7 @@ struct Sheet {
     std::vector<int> offsets, partners;
     std::vector<double> restLength;
     std::vector<std::uint8_t> alive;
+    std::vector<std::uint8_t> kept;  ///< per triangle; empty: all kept
 
     Sheet() = default;
 
@@ -45,7 +46,8 @@ struct Sheet {
           offsets(v.bondOffsets.begin(), v.bondOffsets.end()),
           partners(v.bondPartners.begin(), v.bondPartners.end()),
           restLength(v.bondRestLength.begin(), v.bondRestLength.end()),
-          alive(v.bondAlive.begin(), v.bondAlive.end()) {}
+          alive(v.bondAlive.begin(), v.bondAlive.end()),
+          kept(v.keptTriangles.begin(), v.keptTriangles.end()) {}
 
     int size() const { return int(positions.size()); }
 
@@ -62,15 +64,21 @@ struct Sheet {
                 .bondPartners = partners,
                 .bondRestLength = restLength,
                 .bondAlive = alive,
-                .triangleAlive = {}};
+                .keptTriangles = kept};
     }
 
-    /// Breaks the bond a-b from both ends. Throws std::out_of_range when a and b are not
-    /// bonded, so a test cannot silently break nothing.
+    /// Breaks the bond a-b from both ends, and drops the triangles along it as the
+    /// DamageState does. Throws std::out_of_range when a and b are not bonded, so a test cannot
+    /// silently break nothing.
     void breakBond(int a, int b) {
         const sim::FrameView v = view();
         alive.at(v.findBond(a, b)) = 0;
         alive.at(v.findBond(b, a)) = 0;
+        kept.resize(triangles.size(), 1);
+        for (std::size_t t = 0; t < triangles.size(); ++t)
+            if (std::count(triangles[t].begin(), triangles[t].end(), a) &&
+                std::count(triangles[t].begin(), triangles[t].end(), b))
+                kept[t] = 0;
     }
 
     /// The particle nearest the rest point (x, y).

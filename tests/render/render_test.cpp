@@ -20,8 +20,10 @@
 #include "render/Image.h"
 #include "render/LatticeSurface.h"
 #include "render/OsmesaRenderer.h"
+#include "render/SplatSurface.h"
 #include "render/Versions.h"
 #include "sim/FrameView.h"
+#include "tests/sim/ErodedElement.h"
 
 namespace fs = std::filesystem;
 using rend::render::ColorBy;
@@ -78,17 +80,36 @@ TEST(LatticeSurface, BrokenBoundaryBondDropsItsSingleTriangle) {
 }
 
 TEST(LatticeSurface, ARemovedTriangleIsDroppedAloneWithItsBondsIntact) {
-    // The FEM solver erodes elements: FrameView::triangleAlive drops exactly those triangles,
+    // The FEM solver erodes elements: FrameView::keptTriangles drops exactly those triangles,
     // the neighbours that share their (intact) edges stay.
     const GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
-    std::vector<std::uint8_t> alive(sheet.triangles.size(), 1);
-    alive[7] = 0;
+    std::vector<std::uint8_t> flags(sheet.triangles.size(), 1);
+    flags[7] = 0;
     rend::sim::FrameView view = sheet.view();
-    view.triangleAlive = alive;
+    view.keptTriangles = flags;
     const auto kept = surface.keptTriangles(view);
     EXPECT_EQ(kept.size(), sheet.triangles.size() - 1);
     EXPECT_EQ(std::count(kept.begin(), kept.end(), 7), 0);
+}
+
+TEST(Surfaces, AnErodedFemElementAppearsInNoSurface) {
+    // Its sides are intact (its neighbours hold them): only FrameView::keptTriangles says it
+    // is gone, and both the lattice and the splat surface read that.
+    const rend::sim::MembraneParams p = rend::test::erodingSheet(0.0);
+    rend::sim::Membrane m(p);
+    const int t = rend::test::erodeOneElement(m, p);
+    ASSERT_EQ(m.damageState().removedTriangleCount(), 1u);
+    for (int e : m.damageState().triangleEdges(t)) ASSERT_TRUE(m.damageState().edgeIntact(e));
+    const FrameView view = m.view(1);
+    const std::size_t total = view.restTriangles.size();
+    const auto kept = LatticeSurface(view).keptTriangles(view);
+    EXPECT_EQ(kept.size(), total - 1);
+    EXPECT_EQ(std::count(kept.begin(), kept.end(), t), 0);
+    const auto splat = rend::render::SplatSurface(view).keptTriangles(view);
+    ASSERT_EQ(splat.size(), total);
+    EXPECT_EQ(splat[t], 0);
+    EXPECT_EQ(std::size_t(std::count(splat.begin(), splat.end(), 1)), total - 1);
 }
 
 TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {

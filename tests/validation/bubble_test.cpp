@@ -17,22 +17,21 @@
 #include "tests/validation/checks/HenckyConstant.h"
 
 using namespace rend::checks;
-using rend::sim::SolverKind;
 
 namespace {
 
 constexpr double kNu = 0.45, kE = 1.5e6, kH = 0.35e-3, kRadius = 0.0375, kDx = 1.5e-3;
 
 struct Row {
-    SolverKind solver;
+    std::string solver;
     const char* name;
 };
-constexpr Row kSolvers[] = {{SolverKind::FemCst, "fem_cst"},
-                            {SolverKind::MassSpringTwoParameter, "mass_spring_tp"},
-                            {SolverKind::MassSpringVanGelder, "mass_spring_vg"}};
+constexpr Row kSolvers[] = {{"fem_cst", "fem_cst"},
+                            {"mass_spring_tp", "mass_spring_tp"},
+                            {"mass_spring_vg", "mass_spring_vg"}};
 
 /// Bubble height and Hencky's, at `pressure`.
-std::pair<double, double> bubble(SolverKind solver, double pressure) {
+std::pair<double, double> bubble(std::string solver, double pressure) {
     DiscSpec spec;
     spec.radius = kRadius + 2 * kDx;  // the clamped ring lies outside a = 37.5 mm
     spec.dx = kDx;
@@ -60,7 +59,7 @@ TEST(ValidationBubble, SmallBubblesMatchHenckyAtNuPoint45WhereTheSolverCarriesNu
         const auto [w0, hencky] = bubble(s.solver, load);
         std::printf("bubble w0/a = 0.1 (p = %.0f Pa), %-15s: %.4f mm, Hencky %.4f mm, %+.2f%%\n",
                     load, s.name, 1e3 * w0, 1e3 * hencky, 100 * (w0 / hencky - 1));
-        if (s.solver != SolverKind::MassSpringVanGelder) {
+        if (s.solver != "mass_spring_vg") {
             EXPECT_NEAR(w0 / hencky, 1.0, 0.02) << s.name;
         }
     }

@@ -28,7 +28,7 @@ namespace rend::checks {
 struct NotchedStrip {
     /// Any solver; the others than the peridynamic bonds get nu = 1/3, the bonds' own, so the
     /// strip's Griffith strain is the same for all (checks/CrackRelease.h books them).
-    sim::SolverKind solver = sim::SolverKind::Peridynamic;
+    std::string solver = "peridynamic";
     sim::CriticalStretchMode mode = sim::CriticalStretchMode::Calibrated;
     double dx = 0.01;  ///< m
     double horizonFactor = 1.5;

@@ -54,7 +54,7 @@ struct DiscSpec {
     double radius = 0.5, dx = 0.025;
     double load = 0.0;  ///< pressure [Pa]; 0: the one for w0 = sag * a_c at nu = 1/3
     double sag = 0.1;
-    sim::SolverKind solver = sim::SolverKind::Peridynamic;
+    std::string solver = "peridynamic";
     double youngsModulus = 2e4, poissonRatio = 1.0 / 3.0, thickness = 1e-3, density = 5000;
 };
 Result clampedDisc(const DiscSpec& spec);

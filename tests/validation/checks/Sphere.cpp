@@ -28,7 +28,7 @@ double vanGelderTriangle() {
 
 }  // namespace
 
-SphereResult inflate(SolverKind solver, const Material& mat, double dx) {
+SphereResult inflate(const std::string& solver, const Material& mat, double dx) {
     MembraneParams p;
     p.solver = solver;
     p.sheet.outline = Outline::Sphere;
@@ -75,19 +75,14 @@ double logStrainStretch(const Material& mat) {
     return 0.5 * (lo + hi);
 }
 
-double closedFormStretch(SolverKind solver, const Material& mat) {
+double closedFormStretch(const std::string& solver, const Material& mat) {
     const double k = kPressure * kRadius * (1 - kNu) / (mat.E * mat.h);
-    switch (solver) {
-        case SolverKind::FemCst:
-            return svkStretch(k);
-        case SolverKind::MassSpringVanGelder:
-            return springStretch(kPressure * kRadius /
-                                 (2 * std::sqrt(3.0) * vanGelderTriangle() * mat.E * mat.h));
-        case SolverKind::MassSpringTwoParameter:
-            return springStretch(k);
-        default:
-            return 0.0;
-    }
+    if (solver == "fem_cst") return svkStretch(k);
+    if (solver == "mass_spring_vg")
+        return springStretch(kPressure * kRadius /
+                             (2 * std::sqrt(3.0) * vanGelderTriangle() * mat.E * mat.h));
+    if (solver == "mass_spring_tp") return springStretch(k);
+    return 0.0;
 }
 
 }  // namespace rend::checks

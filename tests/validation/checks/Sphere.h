@@ -36,10 +36,10 @@ struct SphereResult {
 };
 
 /// Inflates the geodesic sphere at spacing dx with `solver` to rest; lambda = cbrt(V / V0).
-SphereResult inflate(sim::SolverKind solver, const Material& mat, double dx);
+SphereResult inflate(const std::string& solver, const Material& mat, double dx);
 
 /// The closed form of `solver`'s own constitutive law (see above).
-double closedFormStretch(sim::SolverKind solver, const Material& mat);
+double closedFormStretch(const std::string& solver, const Material& mat);
 
 /// The log-strain reference (the paper's ANSYS), by bisection.
 double logStrainStretch(const Material& mat);

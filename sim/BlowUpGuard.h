@@ -43,7 +43,8 @@ public:
     static constexpr int kGrowthSteps = 3;        ///< steps in a row that grow by kGrowth
     static constexpr double kBudgetFactor = 4.0;  ///< kinetic energy over the budget
     /// Kinetic energy over the budget that trips the guard however slowly it grew: a step just
-    /// above a solver's true bound can grow by less than kGrowth per step. Far above what the
+    /// above a solver's true bound, or a solver that creates energy, can grow by less than
+    /// kGrowth per step. Far above what the
     /// shipped scenes reach with any solver (README "Blow-up guard").
     static constexpr double kRunawayFactor = 10.0;
     static constexpr double kLightSpeed = 2.998e8;  ///< no speed limit exceeds it [m/s]

@@ -120,12 +120,17 @@ void BlowUpGuard::check(const State& state, const std::function<double()>& total
     growthProduct_ = growing ? growthProduct_ * s.kinetic / lastKinetic_ : 1.0;
     lastKinetic_ = s.kinetic;
     const double allowed = budget_ + thermalEnergy_ * s.maxAbsTheta * s.maxAbsTheta;
-    if (growingSteps_ < kGrowthSteps || !(s.kinetic > kBudgetFactor * allowed)) return;
+    const double ratio = s.kinetic / allowed;
+    const bool fastGrowth = growingSteps_ >= kGrowthSteps && ratio > kBudgetFactor;
+    if (!fastGrowth && !(ratio > kRunawayFactor)) return;
     std::ostringstream why;
     why.precision(3);
-    why << "the kinetic energy grew " << std::pow(growthProduct_, 1.0 / growingSteps_)
-        << "x per step over the last " << growingSteps_ << " steps to " << s.kinetic << " J, "
-        << s.kinetic / allowed
+    if (fastGrowth)
+        why << "the kinetic energy grew " << std::pow(growthProduct_, 1.0 / growingSteps_)
+            << "x per step over the last " << growingSteps_ << " steps to ";
+    else
+        why << "the kinetic energy reached ";
+    why << s.kinetic << " J, " << ratio
         << " times the most the start state, the boundaries, gravity, pressure and expansion "
            "can have put in ("
         << allowed << " J)";

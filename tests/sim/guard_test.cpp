@@ -108,6 +108,27 @@ TEST(BlowUpGuard, AStableRunWithBoundariesGravityPressureAndExpansionNeverTrips)
     EXPECT_NO_THROW(speedHistory(m, m.stableTimeStep(), 1500));
 }
 
+TEST(BlowUpGuard, EnergyFromNowhereStopsTheRunEvenWhenItGrowsSlowly) {
+    // Kinetic energy pumped in by 1.21x per step (below kGrowth) with nothing driving the sheet:
+    // the runaway rule catches it once it is 10x what the run can have put in.
+    MembraneParams p = pulledSheet();
+    p.boundaries.clear();
+    Membrane m(p);
+    m.setTimeStep(0.5 * m.stableTimeStep());
+    m.velocities()[100] = {0.0, 0.0, 0.01};
+    try {
+        for (int s = 0; s < 200; ++s) {
+            m.step();
+            for (auto& v : m.velocities()) v *= 1.1;
+        }
+        FAIL() << "energy pumped in for 200 steps ran without the guard";
+    } catch (const NumericalBlowUp& e) {
+        EXPECT_NE(std::string(e.what()).find("the kinetic energy reached"), std::string::npos)
+            << e.what();
+        EXPECT_LT(m.maxSpeed(), 10.0);
+    }
+}
+
 TEST(BlowUpGuard, LimitsAndMessagesStayFiniteForAbsurdGravity) {
     MembraneParams p = pulledSheet();
     p.gravity = {0.0, 0.0, -1e300};

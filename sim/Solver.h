@@ -102,13 +102,15 @@ public:
     // Conveniences for tests and tools: one call at x (theta none) with a fresh workspace.
     std::vector<Eigen::Vector3d> forcesAt(std::span<const Eigen::Vector3d> x) const {
         std::vector<Eigen::Vector3d> force;
-        forces({x}, *makeWorkspace(), force);
+        forces({x, {}, {}, 0.0}, *makeWorkspace(), force);
         return force;
     }
     double energyAt(std::span<const Eigen::Vector3d> x) const {
-        return strainEnergy({x}, *makeWorkspace());
+        return strainEnergy({x, {}, {}, 0.0}, *makeWorkspace());
     }
-    void fractureAt(std::span<const Eigen::Vector3d> x) { fracture({x}, *makeWorkspace()); }
+    void fractureAt(std::span<const Eigen::Vector3d> x) {
+        fracture({x, {}, {}, 0.0}, *makeWorkspace());
+    }
     std::vector<Eigen::Vector3d> advanceAt(std::span<const Eigen::Vector3d> x,
                                            std::span<const Eigen::Vector3d> v, double dt) {
         std::vector<Eigen::Vector3d> force;

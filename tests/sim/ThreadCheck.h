@@ -34,8 +34,9 @@ inline void expectConsistentDamage(const Membrane& m) {
     for (std::size_t b = 0; b < alive.size(); ++b) {
         broken += alive[b] == 0;
         ASSERT_EQ(alive[b], alive[d.mirror(int(b))]) << "bond " << b;
-        if (const int e = d.bondEdge(int(b)); e >= 0)
+        if (const int e = d.bondEdge(int(b)); e >= 0) {
             ASSERT_EQ(d.edgeIntact(e), alive[b] != 0) << "edge " << e;
+        }
     }
     EXPECT_EQ(broken, 2 * d.brokenBondCount());
     EXPECT_EQ(d.brokenBondCount(), m.brokenBondCount());

@@ -300,7 +300,9 @@ TEST(Solvers, SpringsAndElementsBreakPastTheCriticalStrainAndNeverHeal) {
         // Elements and two-parameter triangles go in bands: sqrt(2 (1 - nu^2)) = 4/3 of it.
         const bool band = s != "mass_spring_vg";
         const double critical = band ? bandCriticalStrain(p) : spring;
-        if (band) ASSERT_NEAR(critical, 4.0 / 3.0 * spring, 1e-15);
+        if (band) {
+            ASSERT_NEAR(critical, 4.0 / 3.0 * spring, 1e-15);
+        }
         for (double factor : {0.98, 1.02}) {
             Membrane m(p);
             // A uniform isotropic stretch: every spring (and the principal strain of every

@@ -150,7 +150,6 @@ double energyPerLength(const NotchedStrip& s, const CrackRecord& r, bool crossin
 
 double rowCrackShare(const Membrane& m) {
     const BondFamilies& bonds = m.bonds();
-    const std::vector<std::uint8_t>& bondAlive = m.damageState().bondAlive();
     // The interior particle is the one whose family sum is largest, as the calibration takes it.
     int interior = 0;
     double best = -1.0;

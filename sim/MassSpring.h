@@ -40,7 +40,7 @@
 //  for e = 0.6). The linear law takes neither path: today's TP bit for bit.
 // A power-law spring in compression stiffens as phi'(eta) ~ s^-4: stiffening() reports phi' of
 // the most compressed spring looked ahead by dt along its rate, as the peridynamic loop does.
-// Yielded springs report eq. 27's gamma to the damage field through bondStrengthLeft().
+// Yielded springs report eq. 27's gamma to the damage field through reportStrength().
 
 #include <Eigen/Geometry>
 #include <array>

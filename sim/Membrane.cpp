@@ -114,20 +114,25 @@ Eigen::Vector3d Membrane::boundaryVelocity(int k, double t) const {
     return ramp * bc.velocity;
 }
 
+// Eq. 26's velocity update of particle i over h: free particles by their force, gravity and
+// damping; pinned ones stay at rest; driven ones take their boundary's velocity at tNext.
+void Membrane::updateVelocity(int i, double h, double tNext, const Eigen::Vector3d& gravity,
+                              double damping) {
+    const std::int16_t c = constraint_[i];
+    if (c == kFree)
+        v_[i] += h * (force_[i] / mass_[i] + gravity - damping * v_[i]);
+    else if (c == kPinned)
+        v_[i].setZero();
+    else
+        v_[i] = boundaryVelocity(c, tNext);
+}
+
 void Membrane::kick(double h, double tNext) {
     const int n = particleCount();
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        const std::int16_t c = constraint_[i];
-        if (c == kFree)
-            v_[i] += h * (force_[i] / mass_[i] + gravity - damping * v_[i]);
-        else if (c == kPinned)
-            v_[i].setZero();
-        else
-            v_[i] = boundaryVelocity(c, tNext);
-    }
+    for (int i = 0; i < n; ++i) updateVelocity(i, h, tNext, gravity, damping);
 }
 
 void Membrane::checkFinite() {
@@ -142,13 +147,7 @@ void Membrane::integrate(double dt, double tNext) {
     const double damping = params_.damping;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
-        const std::int16_t c = constraint_[i];
-        if (c == kFree)
-            v_[i] += dt * (force_[i] / mass_[i] + gravity - damping * v_[i]);
-        else if (c == kPinned)
-            v_[i].setZero();
-        else
-            v_[i] = boundaryVelocity(c, tNext);
+        updateVelocity(i, dt, tNext, gravity, damping);
         x_[i] += dt * v_[i];
     }
 }

@@ -124,6 +124,8 @@ private:
     void stepVelocityVerlet();
     /// v += h * acceleration for free particles; prescribed velocities for the others.
     void kick(double h, double tNext);
+    void updateVelocity(int i, double h, double tNext, const Eigen::Vector3d& gravity,
+                        double damping);
     void checkFinite();  ///< the blow-up guard, after every step
     /// Notches: breaks the bonds they cross and has the solver cut the same edges.
     void setUpNotches(const MembraneParams& params);

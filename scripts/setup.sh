@@ -9,6 +9,7 @@ packages=(
     zlib1g-dev
     libosmesa6-dev libstb-dev libassimp-dev libtomlplusplus-dev libcli11-dev
     libgtest-dev libbenchmark-dev
+    clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer with ASan and UBSan over the loader
 )
 
 missing=()

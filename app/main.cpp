@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -104,6 +105,10 @@ int runCommand(const RunArgs& a) {
     applyOverrides(a, scene);
     rend::RunOptions options;
     options.outDir = a.out;
+    if (std::filesystem::exists(options.outDir) && !std::filesystem::is_directory(options.outDir))
+        throw rend::SceneError("--out " + a.out +
+                               ": error: expected an output folder, found a file. Use another "
+                               "--out, or move the file away.");
     if (!a.frames.empty()) options.frames = rend::parseFrameRange(a.frames, scene.frameCount());
     options.progressBar = isatty(STDERR_FILENO);
     const rend::RunSummary s = rend::runScene(scene, options);

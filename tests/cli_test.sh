@@ -258,5 +258,11 @@ check "absurd gravity is refused at load without inf advice" run 2 run scenes/st
     --set 'forces.gravity=[0,0,-1e300]' --renderer none --out "$tmp/gravity"
 check "absurd gravity message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
 
+# An --out that names a file is bad input, refused before anything is written.
+touch "$tmp/a_file"
+check "--out naming a file refused" run 2 run scenes/stretch.toml --out "$tmp/a_file"
+check "--out naming a file says so" grep -q "^--out .*a_file: error: expected an output folder, found a file" "$tmp/stderr"
+check "--out naming a file leaves it empty" test ! -s "$tmp/a_file"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

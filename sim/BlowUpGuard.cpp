@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numeric>
 #include <sstream>
 
@@ -22,6 +23,33 @@ double suggestedTimeStep(double dt, double stableDt) {
     const double suggested = 0.5 * std::min(dt, stableDt);
     return std::isfinite(suggested) && suggested > 0.0 ? suggested : 0.0;
 }
+
+namespace {
+
+/// Below this fraction of the stable limit a smaller step rarely helps: what grows is energy the
+/// forces themselves put in (a non-conservative solver, a power-law sheet crushed flat).
+constexpr double kWellBelowBound = 0.25;
+
+void adviseOn(std::ostream& out, double dt, double stableDt, double suggested) {
+    if (dt <= kWellBelowBound * stableDt) {
+        out << " The time step " << dt << " s is already " << std::setprecision(2) << stableDt / dt
+            << std::setprecision(6)
+            << " times below the stable limit, so a smaller one is unlikely to help: the forces "
+               "put energy in (the two-parameter springs are not the gradient of an energy and "
+               "can at large strain). Try another solver, add forces.damping, or slow the "
+               "boundary velocities, gravity or pressure.";
+        return;
+    }
+    out << " The time step " << dt << " s against the stable limit " << stableDt
+        << " s is the usual cause; ";
+    if (suggested > 0.0)
+        out << "use dt <= " << suggested << " (or dt = \"auto\")";
+    else
+        out << "use a smaller dt (or dt = \"auto\")";
+    out << ", or slow the boundary velocities, gravity or pressure.";
+}
+
+}  // namespace
 
 BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
                          std::span<const double> mass, std::span<const double> volume) {
@@ -155,13 +183,7 @@ void BlowUpGuard::report(const State& state, const Sample& s, const std::string&
             << " m/s.";
     else
         out << " at " << speed << " m/s.";
-    out << " The time step " << state.dt << " s against the stable limit " << state.stableDt
-        << " s is the usual cause; ";
-    if (suggested > 0.0)
-        out << "use dt <= " << suggested << " (or dt = \"auto\")";
-    else
-        out << "use a smaller dt (or dt = \"auto\")";
-    out << ", or slow the boundary velocities, gravity or pressure.";
+    adviseOn(out, state.dt, state.stableDt, suggested);
     throw NumericalBlowUp(out.str(), state.step, culprit, suggested);
 }
 

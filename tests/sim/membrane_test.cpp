@@ -270,6 +270,21 @@ TEST(Guard, NonFiniteStateStopsWithinOneStepNamingTheParticle) {
     }
 }
 
+TEST(Guard, WellBelowTheStableStepItBlamesTheForcesNotTheStep) {
+    Membrane m(smallSheet(LatticeKind::Hexagonal, 0.3));
+    m.setTimeStep(0.1 * m.stableTimeStep());
+    for (int s = 0; s < 5; ++s) m.step();
+    m.velocities()[42].x() = std::nan("");
+    try {
+        m.step();
+        FAIL() << "no blow-up reported";
+    } catch (const NumericalBlowUp& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("times below the stable limit"), std::string::npos) << message;
+        EXPECT_EQ(message.find("use dt <="), std::string::npos) << message;
+    }
+}
+
 TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
     MembraneParams p = smallSheet(LatticeKind::Hexagonal, 0.4);
     BoundaryCondition pull, pin;

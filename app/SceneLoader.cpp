@@ -14,6 +14,7 @@
 #include "app/SceneError.h"
 #include "app/SceneNames.h"
 #include "app/SceneReader.h"
+#include "render/Look.h"
 #include "sim/SolverRegistry.h"
 
 namespace rend {
@@ -514,6 +515,16 @@ void readImage(const TableReader& t, Scene& scene) {
     r.supersample = int(t.integer("supersample").value_or(r.supersample));
     r.colorBy = render::ColorBy(t.choice("color_by").value_or(std::size_t(r.colorBy)));
     r.colorRange = readColorRange(t);
+    r.thetaStyle = render::ThetaStyle(t.choice("theta_style").value_or(std::size_t(r.thetaStyle)));
+    r.tone.curve = render::ToneCurve(t.choice("tone_map").value_or(std::size_t(r.tone.curve)));
+    r.tone.exposure = t.number("exposure").value_or(r.tone.exposure);
+}
+
+/// A look is a preset: it sets the material keys' defaults, which the scene's own keys
+/// (read after it) override one by one.
+void readLook(const TableReader& t, render::RenderSettings& r) {
+    r.look = render::Look(t.choice("look").value_or(std::size_t(r.look)));
+    if (r.look != render::Look::Plain) render::applyLookPreset(r);
 }
 
 void readPathTracing(const TableReader& t, render::PathTracing& p) {
@@ -557,6 +568,7 @@ void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& s
     const TableReader t = root.section("render");
     render::RenderSettings& r = scene.render;
     readImage(t, scene);
+    readLook(t, r);
     readPathTracing(t, r.pathTracing);
     readSurface(t, r, sheet.dx);
     r.albedo = t.vec3("albedo").value_or(r.albedo);

@@ -22,6 +22,9 @@ inline constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
 inline constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};
 inline constexpr std::string_view kExportFormats[] = {"ply", "obj", "glb", "vdb"};
 inline constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
+inline constexpr std::string_view kLooks[] = {"plain", "foil", "film", "seaweed", "paper"};
+inline constexpr std::string_view kThetaStyles[] = {"layer", "paper_map"};
+inline constexpr std::string_view kToneMaps[] = {"filmic", "clamp"};
 /// The words that stand for "no number": dt = "auto", fracture_energy = "none".
 inline constexpr std::string_view kAuto[] = {"auto"};
 inline constexpr std::string_view kNone[] = {"none"};

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include "render/Look.h"
+
 namespace rend::render {
 
 namespace {
@@ -110,11 +112,33 @@ Eigen::Vector3f colormap(double t) { return sampleSrgb(kViridisSrgb, t); }
 
 Eigen::Vector3f thetaColormap(double t) { return sampleSrgb(kThetaSrgb, t); }
 
+std::vector<Eigen::Vector2f> particleLayers(const sim::FrameView& frame,
+                                            const RenderSettings& settings) {
+    if (!usesLookLayer(settings)) return {};
+    const std::size_t n = frame.particleCount();
+    std::vector<Eigen::Vector2f> layers(n, Eigen::Vector2f::Zero());
+    if (settings.colorBy == ColorBy::Theta) {
+        const std::vector<double> theta = particleField(frame, ColorBy::Theta);
+        const auto [lo, hi] = fieldRange(theta, settings);
+        for (std::size_t i = 0; i < n; ++i) layers[i].x() = float((theta[i] - lo) / (hi - lo));
+    }
+    const std::size_t damaged = std::min(n, frame.damage.size());
+    for (std::size_t i = 0; i < damaged; ++i) layers[i].y() = float(frame.damage[i]);
+    for (auto& l : layers) l = l.cwiseMax(0.0f).cwiseMin(1.0f);
+    return layers;
+}
+
 std::vector<Eigen::Vector3f> particleColors(const sim::FrameView& frame,
                                             const RenderSettings& settings) {
     const std::size_t n = frame.particleCount();
-    if (settings.colorBy == ColorBy::None)
-        return std::vector<Eigen::Vector3f>(n, settings.albedo.cast<float>());
+    if (usesLookLayer(settings)) {
+        const Shading base = baseShading(settings);
+        std::vector<Eigen::Vector3f> colors;
+        colors.reserve(n);
+        for (const Eigen::Vector2f& l : particleLayers(frame, settings))
+            colors.push_back(layeredShading(settings.look, base, l.x(), l.y()).color);
+        return colors;
+    }
     const std::vector<double> field = particleField(frame, settings.colorBy);
     const auto [lo, hi] = fieldRange(field, settings);
     const double span = hi - lo;

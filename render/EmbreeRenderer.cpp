@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "render/GlMath.h"
+#include "render/Look.h"
+#include "render/ToneMap.h"
 
 namespace rend::render {
 
@@ -24,8 +26,6 @@ using Vec3 = Eigen::Vector3f;
 static_assert(sizeof(Vec3) == 3 * sizeof(float), "Vector3f arrays are copied as packed floats");
 
 constexpr float kPi = std::numbers::pi_v<float>;
-// Same encoding as OsmesaRenderer, so the two renderers' frames are comparable.
-constexpr double kGamma = 2.2;
 constexpr int kTileSize = 16;
 // Fresnel reflectance at normal incidence of a dielectric with IOR 1.5: ((n - 1) / (n + 1))^2.
 constexpr float kFilmF0 = 0.04f;
@@ -293,6 +293,8 @@ struct SurfaceHit {
     Vec3 geometricNormal;  ///< unit, facing the incoming ray
     Vec3 shadingNormal;    ///< unit, on the same side as geometricNormal
     Vec3 albedo;
+    float alpha = 0.0f;         ///< the look's GGX alpha here (sheet hits only)
+    float transmission = 0.0f;  ///< the look's transmission here (sheet hits only)
     bool ground = false;
     std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the disc or triangle hit
 };
@@ -366,6 +368,10 @@ struct Tracer {
     const Splats* splats = nullptr;
     Vec3 defaultAlbedo;
     Bsdf material;
+    /// Per vertex (mesh) or disc (splats): the look's (GGX alpha, transmission) under its layer;
+    /// empty: the material's everywhere.
+    std::vector<std::array<float, 2>> layerParams;
+    ToneMapping tone;
     int maxDepth = 1;
     float epsilon = 1e-4f;  ///< ray origin offset, relative to the scene's size
     bool ground = false;
@@ -401,6 +407,7 @@ struct Tracer {
     bool intersect(const Vec3& origin, const Vec3& direction, std::uint32_t fromPrim,
                    SurfaceHit& hit, long long& rays) const;
     void fillSurface(const RTCHit& h, SurfaceHit& hit) const;
+    Bsdf bsdfAt(const SurfaceHit& hit) const;
     Vec3 shadowTransmittance(Vec3 origin, const Vec3& direction, std::uint32_t fromPrim,
                              long long& rays) const;
     Vec3 sunLight(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& frame, const Vec3& wo,
@@ -425,10 +432,29 @@ void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
         const auto& c = mesh->colors;
         hit.albedo =
             c.empty() ? defaultAlbedo : Vec3(w0 * c[tri[0]] + h.u * c[tri[1]] + h.v * c[tri[2]]);
+        if (layerParams.empty()) return;
+        const auto& l = layerParams;
+        hit.alpha = w0 * l[tri[0]][0] + h.u * l[tri[1]][0] + h.v * l[tri[2]][0];
+        hit.transmission = w0 * l[tri[0]][1] + h.u * l[tri[1]][1] + h.v * l[tri[2]][1];
     } else {
         hit.shadingNormal = safeNormalized(splats->normals[h.primID], ng);
         hit.albedo = splats->colors.empty() ? defaultAlbedo : splats->colors[h.primID];
+        if (layerParams.empty()) return;
+        hit.alpha = layerParams[h.primID][0];
+        hit.transmission = layerParams[h.primID][1];
     }
+}
+
+/// The ground is plain Lambert; the sheet is the material with the hit's colour and, where the
+/// look's layer is on, its roughness and transmission.
+Bsdf Tracer::bsdfAt(const SurfaceHit& hit) const {
+    if (hit.ground) return Bsdf{MaterialKind::Diffuse, hit.albedo};
+    Bsdf bsdf = material;
+    bsdf.albedo = hit.albedo;
+    if (layerParams.empty()) return bsdf;
+    bsdf.alpha = hit.alpha;
+    bsdf.transmission = hit.transmission;
+    return bsdf;
 }
 
 bool Tracer::intersect(const Vec3& origin, const Vec3& direction, std::uint32_t fromPrim,
@@ -472,8 +498,7 @@ Vec3 Tracer::shadowTransmittance(Vec3 origin, const Vec3& direction, std::uint32
     for (int layer = 0; layer < kMaxShadowLayers; ++layer) {
         SurfaceHit hit;
         if (!intersect(origin, direction, fromPrim, hit, rays)) return transmittance;
-        Bsdf layerBsdf = material;
-        layerBsdf.albedo = hit.albedo;
+        const Bsdf layerBsdf = bsdfAt(hit);
         transmittance = transmittance.cwiseProduct(
             layerBsdf.straightTransmission(-direction.dot(hit.geometricNormal)));
         if (maxComponent(transmittance) < 1e-3f) break;
@@ -523,8 +548,7 @@ Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays
             break;
         }
         if (depth == maxDepth) break;
-        Bsdf bsdf = hit.ground ? Bsdf{MaterialKind::Diffuse, hit.albedo} : material;
-        if (!hit.ground) bsdf.albedo = hit.albedo;
+        const Bsdf bsdf = bsdfAt(hit);
         const Frame frame(hit.shadingNormal);
         const Vec3 wo = frame.toLocal(-direction);
         result += clampContribution(
@@ -552,7 +576,8 @@ void checkGeometry(const Mesh& mesh) { checkMesh(mesh, "EmbreeRenderer"); }
 void checkGeometry(const Splats& splats) {
     const std::size_t n = splats.centers.size();
     if (splats.normals.size() != n || splats.radii.size() != n ||
-        (!splats.colors.empty() && splats.colors.size() != n))
+        (!splats.colors.empty() && splats.colors.size() != n) ||
+        (!splats.layers.empty() && splats.layers.size() != n))
         throw std::invalid_argument("EmbreeRenderer: splat attribute arrays differ in length");
 }
 
@@ -566,13 +591,32 @@ float sceneScale(const Geometry& geometry, const RenderSettings& s) {
     return scale;
 }
 
+float ggxAlpha(double roughness) { return std::max(kMinAlpha, float(roughness * roughness)); }
+
+/// The look's layer, evaluated once per vertex or disc rather than at every hit. A layer keeps
+/// the material's kind, so the frame-wide kind (film or opaque shadow rays) stays right.
+std::vector<std::array<float, 2>> layerParams(const Geometry& geometry, const RenderSettings& s) {
+    const auto& layers = std::holds_alternative<Mesh>(geometry) ? std::get<Mesh>(geometry).layers
+                                                                : std::get<Splats>(geometry).layers;
+    const Shading base = baseShading(s);
+    std::vector<std::array<float, 2>> params;
+    params.reserve(layers.size());
+    for (const Eigen::Vector2f& l : layers) {
+        const Shading here = layeredShading(s.look, base, l.x(), l.y());
+        params.push_back({ggxAlpha(here.roughness), std::clamp(here.transmission, 0.0f, 1.0f)});
+    }
+    return params;
+}
+
 Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
     const PathTracing& pt = s.pathTracing;
     Tracer tr;
     tr.defaultAlbedo = toFloat(s.albedo);
     tr.material.kind = pt.material;
-    tr.material.alpha = std::max(kMinAlpha, float(pt.roughness * pt.roughness));
+    tr.material.alpha = ggxAlpha(pt.roughness);
     tr.material.transmission = std::clamp(float(pt.transmission), 0.0f, 1.0f);
+    tr.layerParams = layerParams(geometry, s);
+    tr.tone = s.tone;
     tr.maxDepth = std::max(1, pt.maxDepth);
     tr.epsilon = 1e-4f * sceneScale(geometry, s);
     tr.ground = s.ground;
@@ -612,11 +656,6 @@ struct CameraRays {
             .cast<float>();
     }
 };
-
-std::uint8_t encode(double linear) {
-    const double c = std::pow(std::clamp(linear, 0.0, 1.0), 1.0 / kGamma);
-    return static_cast<std::uint8_t>(std::lround(c * 255.0));
-}
 
 }  // namespace
 
@@ -783,7 +822,7 @@ long long EmbreeRenderer::Impl::traceTile(const Tracer& tracer, const CameraRays
                 const Vec3 d = camera.direction(x, y, jx, jy);
                 sum += tracer.radiance(camera.origin, d, rng, rays).cast<double>();
             }
-            for (int k = 0; k < 3; ++k) rgb[pixel * 3 + k] = encode(sum[k] / spp);
+            for (int k = 0; k < 3; ++k) rgb[pixel * 3 + k] = displayByte(sum[k] / spp, tracer.tone);
         }
     }
     return rays;

@@ -14,6 +14,9 @@ struct Mesh {
     std::vector<Eigen::Vector3f> positions;
     std::vector<Eigen::Vector3f> normals;  ///< per vertex, unit length
     std::vector<Eigen::Vector3f> colors;   ///< per vertex, linear RGB in [0,1]
+    /// Per vertex, the look's layer inputs (theta over color_range, damage), each in [0, 1]
+    /// (ColorMap.h particleLayers); empty where a colour map replaces the look.
+    std::vector<Eigen::Vector2f> layers;
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 
@@ -24,7 +27,8 @@ inline void checkMesh(const Mesh& mesh, std::string_view who) {
     const auto fail = [&](const char* what) {
         throw std::invalid_argument(std::string(who) + ": " + what);
     };
-    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
+    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n) ||
+        (!mesh.layers.empty() && mesh.layers.size() != n))
         fail("mesh attribute arrays differ in length");
     for (const auto& t : mesh.triangles)
         for (std::uint32_t v : t)

@@ -4,19 +4,31 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
 #include "render/GlMath.h"
+#include "render/Look.h"
+#include "render/ToneMap.h"
 
 namespace rend::render {
 
 namespace {
 
 // Output encoding: GL shades in linear space into a float buffer, and the box-filtered result
-// is encoded with a plain 2.2 gamma. Filtering before encoding keeps edges from darkening,
-// and the float buffer avoids banding in the shadows that an 8-bit linear buffer would cause.
-constexpr double kGamma = 2.2;
+// is tone mapped and gamma encoded (ToneMap.h). Filtering before encoding keeps edges from
+// darkening, and the float buffer avoids banding in the shadows that an 8-bit linear buffer
+// would cause. Fixed-function GL clamps every lit colour to 1, so all light is drawn at
+// 1 / kHeadroom and scaled back before the tone curve: highlights up to kHeadroom survive.
+constexpr double kHeadroom = 4.0;
+// Fixed-function GL has no environment for a metal to reflect; a fraction of its reflectance
+// as diffuse colour stands in for the sky and ground it would mirror.
+constexpr float kMetalDiffuse = 0.35f;
+// Fresnel reflectance at normal incidence of a dielectric with IOR 1.5, as in the path tracer.
+constexpr float kDielectricF0 = 0.04f;
+// GL's largest specular exponent.
+constexpr float kMaxShininess = 128.0f;
 
 // The ground quad reaches far past anything the camera frames, and fog toward the background
 // colour dissolves its edge into a horizon instead of a visible border.
@@ -55,23 +67,48 @@ void setupLighting(const RenderSettings& s) {
     glEnable(GL_LIGHT0);
     glEnable(GL_NORMALIZE);
     glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
-    const GLfloat ambient[4] = {float(s.ambient), float(s.ambient), float(s.ambient), 1.0f};
+    glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_TRUE);  // highlights where the camera sees them
+    const float a = float(s.ambient / kHeadroom);
+    const GLfloat ambient[4] = {a, a, a, 1.0f};
     glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
     // Issued after the view matrix is loaded, so the direction is taken in world space.
     const Eigen::Vector3d d = s.sun.direction.normalized();
     const GLfloat position[4] = {float(d.x()), float(d.y()), float(d.z()), 0.0f};
     glLightfv(GL_LIGHT0, GL_POSITION, position);
-    setColor(GL_DIFFUSE, s.sun.color * s.sun.intensity);
+    setColor(GL_DIFFUSE, s.sun.color * s.sun.intensity / kHeadroom);
     setColor(GL_AMBIENT, Eigen::Vector3d::Zero());
-    setColor(GL_SPECULAR, Eigen::Vector3d::Zero());
+    setColor(GL_SPECULAR, s.sun.color * s.sun.intensity / kHeadroom);
     glEnable(GL_COLOR_MATERIAL);
     glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    // The previous frame's highlight pass left its specular colour in the material.
+    const GLfloat black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, black);
+}
+
+// A translucent sheet passes part of the sun to its far side: a second light from the opposite
+// direction, which two-sided lighting applies to the face turned away from the sun. The
+// vertex colours are already scaled by 1 - transmission (the reflected part), so the light is
+// scaled by transmission / (1 - transmission): at the material's own transmission the far side
+// gets albedo x transmission of the sun.
+void setupTransmittedSun(const RenderSettings& s, double transmission) {
+    if (transmission <= 0.0) return;
+    const double ratio = std::min(transmission / std::max(1.0 - transmission, 1e-3), 4.0);
+    const Eigen::Vector3d d = -s.sun.direction.normalized();
+    const GLfloat position[4] = {float(d.x()), float(d.y()), float(d.z()), 0.0f};
+    const Eigen::Vector3d c = s.sun.color * s.sun.intensity * ratio / kHeadroom;
+    const GLfloat color[4] = {float(c.x()), float(c.y()), float(c.z()), 1.0f};
+    const GLfloat black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    glEnable(GL_LIGHT1);
+    glLightfv(GL_LIGHT1, GL_POSITION, position);
+    glLightfv(GL_LIGHT1, GL_DIFFUSE, color);
+    glLightfv(GL_LIGHT1, GL_AMBIENT, black);
+    glLightfv(GL_LIGHT1, GL_SPECULAR, black);
 }
 
 void setupFog(const RenderSettings& s) {
     const double dist = cameraDistance(s.camera);
-    const GLfloat color[4] = {float(s.background.x()), float(s.background.y()),
-                              float(s.background.z()), 1.0f};
+    const Eigen::Vector3d fog = s.background / kHeadroom;
+    const GLfloat color[4] = {float(fog.x()), float(fog.y()), float(fog.z()), 1.0f};
     glEnable(GL_FOG);
     glFogi(GL_FOG_MODE, GL_LINEAR);
     glFogfv(GL_FOG_COLOR, color);
@@ -99,18 +136,59 @@ void drawGround(const RenderSettings& s) {
     }
 }
 
-void drawMesh(const Mesh& mesh, const RenderSettings& s) {
-    if (mesh.triangles.empty()) return;
+/// Per-vertex shading of the mesh, each vertex's Shading from its colour and, where the look's
+/// layer is on, its layer: what the diffuse and the specular pass draw with.
+struct VertexShading {
+    std::vector<Eigen::Vector3f> diffuse;
+    std::vector<Eigen::Vector3f> specular;  ///< peak of a normalised lobe, at 1 / kHeadroom
+    float shininess = 1.0f;                 ///< one exponent per pass: the glossiest vertex's
+    bool glossy = false;                    ///< whether any vertex has a highlight
+};
+
+/// The Blinn-Phong exponent equivalent to GGX alpha (Walter et al. 2007: n = 2 / alpha^2 - 2),
+/// capped at GL's limit.
+float phongExponent(float roughness) {
+    const float alpha = std::max(roughness * roughness, 1e-3f);
+    return std::clamp(2.0f / (alpha * alpha) - 2.0f, 1.0f, kMaxShininess);
+}
+
+VertexShading vertexShading(const Mesh& mesh, const RenderSettings& s) {
+    const Shading base = baseShading(s);
+    const std::size_t n = mesh.positions.size();
+    VertexShading out;
+    out.diffuse.resize(n);
+    out.specular.resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+        Shading here = base;
+        if (v < mesh.layers.size())
+            here = layeredShading(s.look, base, mesh.layers[v].x(), mesh.layers[v].y());
+        if (v < mesh.colors.size()) here.color = mesh.colors[v];
+        const bool metal = here.metalness() > 0.0f;
+        // What the sheet reflects diffusely; the transmitted part lights its far side instead.
+        const float kept = 1.0f - std::clamp(here.transmission, 0.0f, 1.0f);
+        out.diffuse[v] = metal ? Eigen::Vector3f(kMetalDiffuse * here.color) : here.color * kept;
+        const float exponent = phongExponent(here.roughness);
+        // The lobe's peak (n + 8) / (8 pi) keeps a rough surface's highlight dim and broad.
+        const float peak = (exponent + 8.0f) / (8.0f * std::numbers::pi_v<float>);
+        // As in the path tracer, only metal and film have a glossy lobe.
+        const bool glossy = metal || here.kind == MaterialKind::Film;
+        const Eigen::Vector3f f0 =
+            metal ? here.color : Eigen::Vector3f::Constant(glossy ? kDielectricF0 : 0.0f);
+        out.specular[v] = (peak / float(kHeadroom)) * f0;
+        if (!glossy) continue;
+        out.shininess = std::max(out.shininess, exponent);
+        out.glossy = true;
+    }
+    return out;
+}
+
+void drawTriangles(const Mesh& mesh, const std::vector<Eigen::Vector3f>& colors) {
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_NORMAL_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
     glVertexPointer(3, GL_FLOAT, sizeof(Eigen::Vector3f), mesh.positions.data());
     glNormalPointer(GL_FLOAT, sizeof(Eigen::Vector3f), mesh.normals.data());
-    if (mesh.colors.empty()) {
-        glColor3d(s.albedo.x(), s.albedo.y(), s.albedo.z());
-    } else {
-        glEnableClientState(GL_COLOR_ARRAY);
-        glColorPointer(3, GL_FLOAT, sizeof(Eigen::Vector3f), mesh.colors.data());
-    }
+    glColorPointer(3, GL_FLOAT, sizeof(Eigen::Vector3f), colors.data());
     glDrawElements(GL_TRIANGLES, GLsizei(mesh.triangles.size() * 3), GL_UNSIGNED_INT,
                    mesh.triangles.data());
     glDisableClientState(GL_COLOR_ARRAY);
@@ -118,9 +196,32 @@ void drawMesh(const Mesh& mesh, const RenderSettings& s) {
     glDisableClientState(GL_VERTEX_ARRAY);
 }
 
-std::uint8_t encode(double linear) {
-    const double c = std::pow(std::clamp(linear, 0.0, 1.0), 1.0 / kGamma);
-    return static_cast<std::uint8_t>(std::lround(c * 255.0));
+/// Highlights drawn over the lit sheet: the same triangles with only the specular term, added.
+/// Fixed-function GL tracks one material colour per vertex, so the diffuse and the specular
+/// colours need a pass each.
+void drawHighlights(const Mesh& mesh, const VertexShading& shading) {
+    const GLfloat black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    glColorMaterial(GL_FRONT_AND_BACK, GL_SPECULAR);
+    glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, black);
+    glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, shading.shininess);
+    glFogfv(GL_FOG_COLOR, black);  // fog fades a highlight out rather than adding haze twice
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    drawTriangles(mesh, shading.specular);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+}
+
+void drawMesh(const Mesh& mesh, const RenderSettings& s) {
+    if (mesh.triangles.empty()) return;
+    const VertexShading shading = vertexShading(mesh, s);
+    setupTransmittedSun(s, s.pathTracing.transmission);
+    drawTriangles(mesh, shading.diffuse);
+    glDisable(GL_LIGHT1);
+    if (shading.glossy) drawHighlights(mesh, shading);
 }
 
 }  // namespace
@@ -133,7 +234,7 @@ struct OsmesaRenderer::Impl {
 
     void makeCurrent(int w, int h);
     Eigen::Vector3d blockMean(int x, int y, int ss) const;  ///< linear mean of one output pixel
-    Image resolve(int outWidth, int outHeight, int ss) const;
+    Image resolve(int outWidth, int outHeight, int ss, const ToneMapping& tone) const;
 };
 
 void OsmesaRenderer::Impl::makeCurrent(int w, int h) {
@@ -158,14 +259,15 @@ Eigen::Vector3d OsmesaRenderer::Impl::blockMean(int x, int y, int ss) const {
     return sum / double(ss * ss);
 }
 
-Image OsmesaRenderer::Impl::resolve(int outWidth, int outHeight, int ss) const {
+Image OsmesaRenderer::Impl::resolve(int outWidth, int outHeight, int ss,
+                                    const ToneMapping& tone) const {
     Image image{outWidth, outHeight,
                 std::vector<std::uint8_t>(std::size_t(outWidth) * outHeight * 3)};
     for (int y = 0; y < outHeight; ++y) {
         for (int x = 0; x < outWidth; ++x) {
             const Eigen::Vector3d c = blockMean(x, y, ss);
             std::uint8_t* out = &image.rgb[(std::size_t(y) * outWidth + x) * 3];
-            for (int k = 0; k < 3; ++k) out[k] = encode(c[k]);
+            for (int k = 0; k < 3; ++k) out[k] = displayByte(kHeadroom * c[k], tone);
         }
     }
     return image;
@@ -196,7 +298,7 @@ Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings) {
     const int h = settings.height * ss;
     impl_->makeCurrent(w, h);
     glViewport(0, 0, w, h);
-    const auto& bg = settings.background;
+    const Eigen::Vector3d bg = settings.background / kHeadroom;
     glClearColor(float(bg.x()), float(bg.y()), float(bg.z()), 1.0f);
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -208,7 +310,7 @@ Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings) {
     if (settings.ground) drawGround(settings);
     drawMesh(mesh, settings);
     glFinish();
-    return impl_->resolve(settings.width, settings.height, ss);
+    return impl_->resolve(settings.width, settings.height, ss, settings.tone);
 }
 
 std::string OsmesaRenderer::glDescription() {

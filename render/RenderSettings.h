@@ -7,9 +7,28 @@
 
 namespace rend::render {
 
-/// Theta: the diffusive quantity, light red -> dark red as in the membrane paper's figures.
-/// Damage: per-particle damage in [0, 1].
+/// Theta: the diffusive quantity, as a layer on the look (ThetaStyle::Layer) or light red ->
+/// dark red as in the membrane paper's figures (ThetaStyle::PaperMap). Speed, Strain, Damage:
+/// diagnostic maps that replace the look's colour.
 enum class ColorBy { None, Speed, Strain, Theta, Damage };
+
+/// What the sheet is made of, as a shading preset (render/Look.h): the material at theta = 0
+/// and what the diffusing quantity does to it. Plain: the material, albedo, roughness and
+/// transmission keys alone, theta as a red stain.
+enum class Look { Plain, Foil, Film, Seaweed, Paper };
+
+/// How color_by = "theta" shows: as the look's layer (heat tint, damp, etch, wet), or the
+/// membrane paper's light-to-dark-red map replacing the material's colour.
+enum class ThetaStyle { Layer, PaperMap };
+
+/// Linear radiance to display: a filmic curve that rolls highlights off (render/ToneMap.h), or
+/// a plain clamp at 1.
+enum class ToneCurve { Filmic, Clamp };
+
+struct ToneMapping {
+    ToneCurve curve = ToneCurve::Filmic;
+    double exposure = 0.0;  ///< stops: radiance is scaled by 2^exposure before the curve
+};
 
 struct Camera {
     Eigen::Vector3d position{0.0, -4.0, 3.0};
@@ -63,7 +82,10 @@ struct RenderSettings {
     bool ground = true;
     double groundHeight = -0.5;  ///< z of the ground plane
     Eigen::Vector3d groundColor{0.55, 0.55, 0.52};
-    Eigen::Vector3d albedo{0.78, 0.80, 0.85};  ///< material colour when ColorBy::None
+    Eigen::Vector3d albedo{0.78, 0.80, 0.85};  ///< material colour at theta = 0
+    Look look = Look::Plain;
+    ThetaStyle thetaStyle = ThetaStyle::Layer;
+    ToneMapping tone;
     ColorBy colorBy = ColorBy::None;
     std::optional<std::array<double, 2>> colorRange;  ///< nullopt: 0..max of the frame
     SurfaceKind surface = SurfaceKind::Lattice;

@@ -196,6 +196,7 @@ Splats SplatSurface::build(const sim::FrameView& frame, const RenderSettings& se
         if (!fromTriangles[i])
             splats.normals[i] = fallbackNormal(frame, splats.normals, fromTriangles, i);
     splats.colors = particleColors(frame, settings);
+    splats.layers = particleLayers(frame, settings);
     return splats;
 }
 
@@ -224,6 +225,8 @@ Mesh splatsToMesh(const Splats& splats, int segments) {
         const Eigen::Vector3f color =
             d < splats.colors.size() ? splats.colors[d] : Eigen::Vector3f::Constant(0.8f);
         mesh.colors.insert(mesh.colors.end(), perDisc, color);
+        if (d < splats.layers.size())
+            mesh.layers.insert(mesh.layers.end(), perDisc, splats.layers[d]);
     }
     return mesh;
 }

@@ -10,6 +10,7 @@ struct Splats {
     std::vector<Eigen::Vector3f> centers;
     std::vector<Eigen::Vector3f> normals;  ///< unit, from each particle's neighbourhood
     std::vector<Eigen::Vector3f> colors;   ///< linear RGB
+    std::vector<Eigen::Vector2f> layers;   ///< the look's layer inputs, as Mesh::layers
     std::vector<float> radii;
 };
 

@@ -219,17 +219,20 @@ private:
     std::vector<int> order_;
 };
 
-std::vector<Eigen::Vector3f> nearestParticleColors(const sim::FrameView& frame,
-                                                   const RenderSettings& settings, const Mesh& mesh,
-                                                   double cell) {
+/// Each vertex takes its nearest particle's colour and look layer.
+void nearestParticleColors(const sim::FrameView& frame, const RenderSettings& settings, Mesh& mesh,
+                           double cell) {
     const std::vector<Eigen::Vector3f> particle = particleColors(frame, settings);
+    const std::vector<Eigen::Vector2f> layers = particleLayers(frame, settings);
     const ParticleHash hash(frame.positions, cell);
-    std::vector<Eigen::Vector3f> colors(mesh.positions.size(), settings.albedo.cast<float>());
+    mesh.colors.assign(mesh.positions.size(), settings.albedo.cast<float>());
+    if (!layers.empty()) mesh.layers.assign(mesh.positions.size(), Eigen::Vector2f::Zero());
     for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
         const int nearest = hash.nearest(mesh.positions[v].cast<double>());
-        if (nearest >= 0 && std::size_t(nearest) < particle.size()) colors[v] = particle[nearest];
+        if (nearest < 0) continue;
+        if (std::size_t(nearest) < particle.size()) mesh.colors[v] = particle[nearest];
+        if (std::size_t(nearest) < layers.size()) mesh.layers[v] = layers[nearest];
     }
-    return colors;
 }
 
 }  // namespace
@@ -319,7 +322,7 @@ Mesh VdbSurface::build(const sim::FrameView& frame, const RenderSettings& settin
     // Every surface point lies about one radius from its nearest particle, so cells of two
     // radii find it in the first ring of cells (cells of one radius needed a second ring, 5x
     // the lookups, for most vertices).
-    mesh.colors = nearestParticleColors(frame, settings, mesh, 2.0 * radius_);
+    nearestParticleColors(frame, settings, mesh, 2.0 * radius_);
     grid_ = std::make_unique<Grid>(Grid{std::move(grid)});
     return mesh;
 }

@@ -397,7 +397,7 @@ TEST(ColorMap, ThetaAndDamageFieldsAreTheFrameValuesOrZeros) {
     EXPECT_EQ(rend::render::particleField(view, ColorBy::Damage), damage);
 }
 
-TEST(ColorMap, ThetaUsesTheRedMapAndDamageViridis) {
+TEST(ColorMap, ThetaAsThePaperMapUsesTheRedMapAndDamageViridis) {
     GridSheet sheet(2, 2, 1.0);
     const std::vector<double> values{0.0, 1.0, 2.0, 4.0};
     FrameView view = sheet.view();
@@ -405,6 +405,7 @@ TEST(ColorMap, ThetaUsesTheRedMapAndDamageViridis) {
     view.damage = values;
     RenderSettings settings;
     settings.colorBy = ColorBy::Theta;
+    settings.thetaStyle = rend::render::ThetaStyle::PaperMap;
     auto colors = rend::render::particleColors(view, settings);
     EXPECT_TRUE(colors[0].isApprox(rend::render::thetaColormap(0.0)));
     EXPECT_TRUE(colors[2].isApprox(rend::render::thetaColormap(0.5)));

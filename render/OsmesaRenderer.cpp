@@ -86,16 +86,12 @@ void setupLighting(const RenderSettings& s) {
 }
 
 // A translucent sheet passes part of the sun to its far side: a second light from the opposite
-// direction, which two-sided lighting applies to the face turned away from the sun. The
-// vertex colours are already scaled by 1 - transmission (the reflected part), so the light is
-// scaled by transmission / (1 - transmission): at the material's own transmission the far side
-// gets albedo x transmission of the sun.
+// direction, which two-sided lighting applies to the face turned away from the sun.
 void setupTransmittedSun(const RenderSettings& s, double transmission) {
     if (transmission <= 0.0) return;
-    const double ratio = std::min(transmission / std::max(1.0 - transmission, 1e-3), 4.0);
     const Eigen::Vector3d d = -s.sun.direction.normalized();
     const GLfloat position[4] = {float(d.x()), float(d.y()), float(d.z()), 0.0f};
-    const Eigen::Vector3d c = s.sun.color * s.sun.intensity * ratio / kHeadroom;
+    const Eigen::Vector3d c = s.sun.color * s.sun.intensity * transmission / kHeadroom;
     const GLfloat color[4] = {float(c.x()), float(c.y()), float(c.z()), 1.0f};
     const GLfloat black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     glEnable(GL_LIGHT1);
@@ -164,8 +160,12 @@ VertexShading vertexShading(const Mesh& mesh, const RenderSettings& s) {
             here = layeredShading(s.look, base, mesh.layers[v].x(), mesh.layers[v].y());
         if (v < mesh.colors.size()) here.color = mesh.colors[v];
         const bool metal = here.metalness() > 0.0f;
-        // What the sheet reflects diffusely; the transmitted part lights its far side instead.
-        const float kept = 1.0f - std::clamp(here.transmission, 0.0f, 1.0f);
+        // A film's transmitted light passes straight through rather than scattering; a
+        // translucent sheet's comes back out on both sides, which the preview's weak ambient
+        // light would otherwise miss, so only film loses it.
+        const float kept = here.kind == MaterialKind::Film
+                               ? 1.0f - std::clamp(here.transmission, 0.0f, 1.0f)
+                               : 1.0f;
         out.diffuse[v] = metal ? Eigen::Vector3f(kMetalDiffuse * here.color) : here.color * kept;
         const float exponent = phongExponent(here.roughness);
         // The lobe's peak (n + 8) / (8 pi) keeps a rough surface's highlight dim and broad.

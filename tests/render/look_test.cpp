@@ -250,6 +250,62 @@ TEST(Look, WetPaperRendersDarkerThanDryInBothRenderers) {
     }
 }
 
+namespace {
+
+// A crinkled 2 x 1.2 foil with one heat spot (theta 1 at its centre, falling off over 0.5),
+// as a mesh with per-vertex layers: the temper rings of the foil look, in a reference image.
+render::Mesh heatedFoil(const render::RenderSettings& settings) {
+    constexpr int kNx = 41, kNy = 25;
+    auto height = [](float x, float y) {
+        return 0.06f * std::sin(9.0f * x + 2.0f * y) + 0.04f * std::sin(13.0f * y - 4.0f * x);
+    };
+    render::Mesh mesh = rend::test::gridMesh(kNx, kNy, [&](int i, int j) {
+        const float x = -1.0f + 0.05f * float(i), y = -0.6f + 0.05f * float(j);
+        const float h = 1e-3f;
+        const float gx = (height(x + h, y) - height(x - h, y)) / (2 * h);
+        const float gy = (height(x, y + h) - height(x, y - h)) / (2 * h);
+        return rend::test::GridVertex{Eigen::Vector3f(x, y, height(x, y)),
+                                      Eigen::Vector3f(-gx, -gy, 1.0f).normalized(),
+                                      Eigen::Vector3f::Zero()};
+    });
+    const render::Shading base = render::baseShading(settings);
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const float r = Eigen::Vector2f(mesh.positions[v].x() - 0.2f, mesh.positions[v].y()).norm();
+        const float theta = std::max(0.0f, 1.0f - r / 0.5f);
+        mesh.layers.emplace_back(theta, 0.0f);
+        mesh.colors[v] = render::layeredShading(settings.look, base, theta, 0.0f).color;
+    }
+    return mesh;
+}
+
+render::RenderSettings foilView() {
+    render::RenderSettings settings;
+    settings.look = Look::Foil;
+    render::applyLookPreset(settings);
+    settings.width = 160;
+    settings.height = 90;
+    settings.camera.position = Eigen::Vector3d(0.3, -2.2, 1.6);
+    settings.camera.lookAt = Eigen::Vector3d(0.0, 0.0, -0.1);
+    settings.sun.direction = Eigen::Vector3d(-0.3, 0.8, 0.9);
+    settings.groundHeight = -0.4;
+    settings.pathTracing.samplesPerPixel = 16;
+    settings.pathTracing.maxDepth = 3;
+    settings.pathTracing.skyZenith = Eigen::Vector3d(0.12, 0.16, 0.26);
+    settings.pathTracing.skyHorizon = Eigen::Vector3d(0.95, 0.93, 0.88);
+    return settings;
+}
+
+}  // namespace
+
+TEST(Look, HeatedFoilMatchesItsReferenceImagesInBothRenderers) {
+    const render::RenderSettings settings = foilView();
+    const render::Mesh mesh = heatedFoil(settings);
+    rend::test::expectMatchesReference(render::EmbreeRenderer().render(mesh, settings),
+                                       "look_embree_foil");
+    rend::test::expectMatchesReference(render::OsmesaRenderer().render(mesh, settings),
+                                       "look_osmesa_foil");
+}
+
 // ---- Tone curve -----------------------------------------------------------------------------
 
 TEST(ToneMap, FilmicCurveIsMonotonicAndNeverReachesWhite) {

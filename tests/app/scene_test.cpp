@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/SceneError.h"
+#include "render/Look.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -378,6 +379,24 @@ TEST_F(SceneTest, ColorByThetaAndDamage) {
               render::ColorBy::Damage);
     EXPECT_NE(errorOf(kStretch, {"render.color_by=damag"}).find("Did you mean \"damage\"?"),
               std::string::npos);
+}
+
+TEST_F(SceneTest, ALookIsAPresetThatTheScenesOwnKeysOverride) {
+    const Scene foil = loadScene(kStretch, {"render.look=foil"});
+    EXPECT_EQ(foil.render.look, render::Look::Foil);
+    EXPECT_EQ(foil.render.pathTracing.material, render::MaterialKind::Conductor);
+    EXPECT_FLOAT_EQ(float(foil.render.pathTracing.roughness),
+                    render::lookPreset(render::Look::Foil).roughness);
+    const Scene rough = loadScene(kStretch, {"render.look=foil", "render.roughness=0.6"});
+    EXPECT_DOUBLE_EQ(rough.render.pathTracing.roughness, 0.6);
+    EXPECT_EQ(rough.render.pathTracing.material, render::MaterialKind::Conductor);
+    const Scene paper = loadScene(kStretch, {"render.look=paper", "render.theta_style=paper_map",
+                                             "render.tone_map=clamp", "render.exposure=-1.5"});
+    EXPECT_EQ(paper.render.thetaStyle, render::ThetaStyle::PaperMap);
+    EXPECT_EQ(paper.render.tone.curve, render::ToneCurve::Clamp);
+    EXPECT_DOUBLE_EQ(paper.render.tone.exposure, -1.5);
+    EXPECT_EQ(loadScene(kStretch).render.tone.curve, render::ToneCurve::Filmic);
+    EXPECT_NE(errorOf(kStretch, {"render.look=nori"}).find("\"seaweed\""), std::string::npos);
 }
 
 TEST_F(SceneTest, SetOverridesValues) {

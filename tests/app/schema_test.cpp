@@ -141,21 +141,24 @@ colour_by = "strain"
         loadScene(file);
         FAIL() << "no SceneError";
     } catch (const SceneError& e) {
-        EXPECT_EQ(std::string(e.what()),
-                  file.string() +
-                      ":23:1: error: unknown key 'widht' in [render]; expected one of: "
-                      "renderer, width, height, supersample, color_by, color_range, albedo, "
-                      "background, ground_color, ground, ground_height, spp, max_depth, "
-                      "material, roughness, transmission, sky, sun_radius, sky_zenith, "
-                      "sky_horizon, surface, thickness, vdb_voxel_size, vdb_particle_radius, "
-                      "vdb_smoothing, vdb_adaptivity. Did you mean 'width'?\n" +
-                      file.string() +
-                      ":24:1: error: unknown key 'colour_by' in [render]; expected one of: "
-                      "renderer, width, height, supersample, color_by, color_range, albedo, "
-                      "background, ground_color, ground, ground_height, spp, max_depth, "
-                      "material, roughness, transmission, sky, sun_radius, sky_zenith, "
-                      "sky_horizon, surface, thickness, vdb_voxel_size, vdb_particle_radius, "
-                      "vdb_smoothing, vdb_adaptivity. Did you mean 'color_by'?");
+        EXPECT_EQ(
+            std::string(e.what()),
+            file.string() +
+                ":23:1: error: unknown key 'widht' in [render]; expected one of: "
+                "renderer, width, height, supersample, look, color_by, theta_style, tone_map, "
+                "exposure, color_range, albedo, "
+                "background, ground_color, ground, ground_height, spp, max_depth, "
+                "material, roughness, transmission, sky, sun_radius, sky_zenith, "
+                "sky_horizon, surface, thickness, vdb_voxel_size, vdb_particle_radius, "
+                "vdb_smoothing, vdb_adaptivity. Did you mean 'width'?\n" +
+                file.string() +
+                ":24:1: error: unknown key 'colour_by' in [render]; expected one of: "
+                "renderer, width, height, supersample, look, color_by, theta_style, tone_map, "
+                "exposure, color_range, albedo, "
+                "background, ground_color, ground, ground_height, spp, max_depth, "
+                "material, roughness, transmission, sky, sun_radius, sky_zenith, "
+                "sky_horizon, surface, thickness, vdb_voxel_size, vdb_particle_radius, "
+                "vdb_smoothing, vdb_adaptivity. Did you mean 'color_by'?");
     }
 }
 

@@ -30,8 +30,8 @@ constexpr float kTint[5][3] = {
 // more passes through (paper), and a water film smooths the surface (glossier nori). The
 // target values are eyeballed from photographs of wet paper towel and damp nori.
 constexpr float kDampRoughness = 0.22f;  // seaweed under a water film
-constexpr float kDampDarkening = 0.55f;  // nori albedo factor where fully damp
-constexpr float kWetDarkening = 0.45f;   // paper albedo factor where soaked
+constexpr float kDampDarkening = 0.45f;  // nori albedo factor where fully damp
+constexpr float kWetDarkening = 0.30f;   // paper albedo factor where soaked
 constexpr float kWetTransmission = 0.80f;
 // Acid etching frosts a clear film: micro-pits scatter (rough, clouded) and yellow it.
 constexpr float kEtchedRoughness = 0.80f;
@@ -47,9 +47,14 @@ Shading foil(Shading s, float t, float d) {
     return s;
 }
 
+// How wet a surface looks at moisture t: the first water fills the pores and does most of the
+// darkening, so the response eases out (monotonic, 0 at 0, 1 at 1).
+float wetness(float t) { return 1.0f - (1.0f - t) * (1.0f - t); }
+
 Shading seaweed(Shading s, float t) {
-    s.color *= lerp(1.0f, kDampDarkening, t);
-    s.roughness = lerp(s.roughness, std::min(s.roughness, kDampRoughness), t);
+    const float w = wetness(t);
+    s.color *= lerp(1.0f, kDampDarkening, w);
+    s.roughness = lerp(s.roughness, std::min(s.roughness, kDampRoughness), w);
     return s;
 }
 
@@ -61,8 +66,9 @@ Shading film(Shading s, float t, float d) {
 }
 
 Shading paper(Shading s, float t, float d) {
-    s.color = lerp(s.color * lerp(1.0f, kWetDarkening, t), kWhitened, 0.3f * d);
-    s.transmission = lerp(s.transmission, std::max(s.transmission, kWetTransmission), t);
+    const float w = wetness(t);
+    s.color = lerp(s.color * lerp(1.0f, kWetDarkening, w), kWhitened, 0.3f * d);
+    s.transmission = lerp(s.transmission, std::max(s.transmission, kWetTransmission), w);
     return s;
 }
 

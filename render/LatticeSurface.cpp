@@ -319,22 +319,36 @@ void LatticeSurface::walkFan(int start, int particle, std::uint32_t vertex,
     }
 }
 
+// Only particles at a triangle dropped whole can have more than one fan: around any other, the
+// present triangles run unbroken around it, so its corners simply keep its own vertex.
 LatticeSurface::Corners LatticeSurface::splitFans(const std::vector<std::uint8_t>& present,
                                                   std::size_t particleCount) const {
     Corners corners;
-    corners.vertex.assign(triangles_.size(), {kUnassigned, kUnassigned, kUnassigned});
+    corners.vertex.resize(triangles_.size());
+    std::vector<int> atDropped;
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            corners.vertex[t][k] = static_cast<std::uint32_t>(triangles_[t][k]);
+            if (!present[t]) atDropped.push_back(triangles_[t][k]);
+        }
+    }
+    std::sort(atDropped.begin(), atDropped.end());
+    atDropped.erase(std::unique(atDropped.begin(), atDropped.end()), atDropped.end());
     std::vector<int> stack;
-    for (int p = 0; p + 1 < static_cast<int>(incidentOffsets_.size()); ++p) {
-        bool first = true;
-        for (int k = incidentOffsets_[p]; k < incidentOffsets_[p + 1]; ++k) {
+    for (int p : atDropped) {
+        const int first = incidentOffsets_[p], last = incidentOffsets_[p + 1];
+        for (int k = first; k < last; ++k)
+            corners.vertex[incident_[k]][cornerOf(incident_[k], p)] = kUnassigned;
+        bool own = true;
+        for (int k = first; k < last; ++k) {
             const int t = incident_[k];
             if (!present[t] || corners.vertex[t][cornerOf(t, p)] != kUnassigned) continue;
             std::uint32_t vertex = static_cast<std::uint32_t>(p);
-            if (!first) {
+            if (!own) {
                 vertex = static_cast<std::uint32_t>(particleCount + corners.copyOf.size());
                 corners.copyOf.push_back(p);
             }
-            first = false;
+            own = false;
             walkFan(t, p, vertex, present, corners, stack);
         }
     }
@@ -366,7 +380,8 @@ public:
           x_(placed.x),
           rest_(placed.rest),
           mesh_(mesh) {
-        const std::vector<Eigen::Vector3f> colours = particleColors(frame, settings);
+        colours_ = particleColors(frame, settings);
+        const std::vector<Eigen::Vector3f>& colours = colours_;
         const std::size_t vertices = x_.size() + corners.copyOf.size() + 2 * cuts.edges.size();
         mesh.positions.reserve(vertices);
         mesh.colors.reserve(vertices);
@@ -380,7 +395,6 @@ public:
             add(lipPosition(i, j, t), colour);
             add(lipPosition(j, i, 1.0 - t), colour);
         }
-        colours_ = colours;
         mesh.triangles.reserve(s_.triangles_.size() + 3 * cuts.edges.size());
     }
 
@@ -444,7 +458,7 @@ private:
     }
 
     /// The crossing at fraction t of the way from particle a to b, on a's side.
-    Eigen::Vector3d lipPosition(int a, int b, double t) const {
+    Eigen::Vector3d lipPosition(int a, int b, double t) {
         return ownSide(a, (1.0 - t) * rest_[a] + t * rest_[b], (1.0 - t) * x_[a] + t * x_[b]);
     }
 
@@ -454,7 +468,7 @@ private:
     /// crack) where it is no farther from a than at rest, else that rest distance from a
     /// towards it, in a's tangent plane.
     Eigen::Vector3d ownSide(int a, const Eigen::Vector3d& restTarget,
-                            const Eigen::Vector3d& target) const {
+                            const Eigen::Vector3d& target) {
         const Eigen::Vector3d offset = restTarget - rest_[a];
         Eigen::Matrix3d F;
         if (deformation(a, F) || neighbourDeformation(a, F)) return x_[a] + F * offset;
@@ -470,7 +484,7 @@ private:
 
     /// The deformation of the first intact neighbour that has one: a particle at a corner of
     /// its piece may have a single intact side.
-    bool neighbourDeformation(int a, Eigen::Matrix3d& F) const {
+    bool neighbourDeformation(int a, Eigen::Matrix3d& F) {
         for (int k = s_.incidentOffsets_[a]; k < s_.incidentOffsets_[a + 1]; ++k) {
             const int t = s_.incident_[k];
             if (!cuts_.present[t]) continue;
@@ -488,7 +502,23 @@ private:
     /// The least-squares deformation gradient F (x_j - x_a ~ F (X_j - X_a)) over particle a's
     /// lattice neighbours through intact sides, on a's rest tangent plane; false where those
     /// neighbours do not span the plane (fewer than two directions).
-    bool deformation(int a, Eigen::Matrix3d& F) const {
+    bool deformation(int a, Eigen::Matrix3d& F) {
+        // Each particle's is fitted once per frame: a particle owns several lip vertices.
+        if (fitted_.empty()) fitted_.assign(x_.size(), kNotFitted);
+        int& slot = fitted_[a];
+        if (slot == kNotFitted) {
+            slot = kNoFit;
+            if (fitDeformation(a, F)) {
+                slot = static_cast<int>(fits_.size());
+                fits_.push_back(F);
+            }
+        }
+        if (slot == kNoFit) return false;
+        F = fits_[slot];
+        return true;
+    }
+
+    bool fitDeformation(int a, Eigen::Matrix3d& F) const {
         Eigen::Matrix3d moved = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
         for (int k = s_.incidentOffsets_[a]; k < s_.incidentOffsets_[a + 1]; ++k) {
             const int t = s_.incident_[k];
@@ -536,6 +566,9 @@ private:
     std::vector<Eigen::Vector3f> colours_;
     Mesh& mesh_;
     std::uint32_t lipBase_ = 0;
+    static constexpr int kNotFitted = -1, kNoFit = -2;
+    std::vector<int> fitted_;  ///< per particle: index into fits_, or kNotFitted / kNoFit
+    std::vector<Eigen::Matrix3d> fits_;
 };
 
 Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& settings) const {

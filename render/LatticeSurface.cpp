@@ -165,6 +165,46 @@ struct LatticeSurface::Cuts {
     bool broken(int e) const { return index[e] >= 0; }
 };
 
+/// One frame's positions: the particles', but for the outline's notch particles, which move
+/// onto the outline (rest position too) while both their outline bonds hold. Looked up, not
+/// copied: the cut reads only a few.
+class LatticeSurface::Placed {
+public:
+    Placed(const LatticeSurface& surface, const sim::FrameView& frame)
+        : s_(surface), frame_(frame), holds_(surface.notches_.size(), 0) {
+        const auto holds = [&](int b) {
+            return b < 0 || frame.bondAlive.empty() || frame.bondAlive[b];
+        };
+        for (std::size_t k = 0; k < holds_.size(); ++k)
+            holds_[k] = holds(s_.notches_[k].bondP) && holds(s_.notches_[k].bondN);
+    }
+
+    std::size_t size() const { return frame_.positions.size(); }
+
+    Eigen::Vector3d x(int v) const {
+        const Notch* notch = moved(v);
+        return notch ? Eigen::Vector3d(0.5 *
+                                       (frame_.positions[notch->p] + frame_.positions[notch->n]))
+                     : frame_.positions[v];
+    }
+
+    Eigen::Vector3d rest(int v) const {
+        const Notch* notch = moved(v);
+        return notch ? Eigen::Vector3d(0.5 * (s_.rest_[notch->p] + s_.rest_[notch->n]))
+                     : s_.rest_[v];
+    }
+
+private:
+    const Notch* moved(int v) const {
+        const int k = v < static_cast<int>(s_.notchOf_.size()) ? s_.notchOf_[v] : -1;
+        return k >= 0 && holds_[k] ? &s_.notches_[k] : nullptr;
+    }
+
+    const LatticeSurface& s_;
+    const sim::FrameView& frame_;
+    std::vector<std::uint8_t> holds_;  ///< per notch
+};
+
 LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
       edges_(restEdges(triangles_)),
@@ -185,9 +225,11 @@ LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     for (auto& n : restNormal_)
         n = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::UnitZ();
     const auto notches = outlineNotches(triangles_, edges_, rest_);
+    notchOf_.assign(notches.size(), -1);
     for (int v = 0; v < int(notches.size()); ++v) {
         const auto [p, n] = notches[v];
         if (p < 0) continue;
+        notchOf_[v] = static_cast<int>(notches_.size());
         notches_.push_back({v, p, n, bond(v, p), bond(v, n)});
     }
 }
@@ -231,7 +273,7 @@ LatticeSurface::Cuts LatticeSurface::findCuts(const sim::FrameView& frame) const
 // its edge, the other crossing of a triangle with two broken sides, or the centroid of one
 // with one or three (the tip's slit and the junction meet there).
 void LatticeSurface::placeCrossings(const Placed& placed, Cuts& cuts) const {
-    const std::vector<Eigen::Vector3d>& rest = placed.rest;
+    const auto rest = [&](int v) { return placed.rest(v); };
     struct Link {
         int crossing = -1;  ///< index into cuts.edges, or -1 for `point`
         Eigen::Vector3d point = Eigen::Vector3d::Zero();
@@ -255,14 +297,14 @@ void LatticeSurface::placeCrossings(const Placed& placed, Cuts& cuts) const {
             continue;
         }
         const auto& c = triangles_[t];
-        const Eigen::Vector3d centroid = (rest[c[0]] + rest[c[1]] + rest[c[2]]) / 3.0;
+        const Eigen::Vector3d centroid = (rest(c[0]) + rest(c[1]) + rest(c[2])) / 3.0;
         for (int e : side)
             if (cuts.broken(e)) add(e, {-1, centroid, true});
     }
     const auto at = [&](const std::vector<double>& t, const Link& link) -> Eigen::Vector3d {
         if (link.crossing < 0) return link.point;
         const auto& [i, j] = edges_.ends[cuts.edges[link.crossing]];
-        return (1.0 - t[link.crossing]) * rest[i] + t[link.crossing] * rest[j];
+        return (1.0 - t[link.crossing]) * rest(i) + t[link.crossing] * rest(j);
     };
     std::vector<double> next(cuts.t.size());
     for (int pass = 0; pass < kSmoothingPasses; ++pass) {
@@ -283,7 +325,7 @@ void LatticeSurface::placeCrossings(const Placed& placed, Cuts& cuts) const {
                 continue;
             }
             const auto& [i, j] = edges_.ends[cuts.edges[k]];
-            const double s = crossingParameter(rest[i], rest[j], a, b);
+            const double s = crossingParameter(rest(i), rest(j), a, b);
             if (std::isfinite(s)) next[k] = std::clamp(s, kCrossingMargin, 1.0 - kCrossingMargin);
         }
         cuts.t.swap(next);
@@ -355,38 +397,20 @@ LatticeSurface::Corners LatticeSurface::splitFans(const std::vector<std::uint8_t
     return corners;
 }
 
-LatticeSurface::Placed LatticeSurface::place(const sim::FrameView& frame) const {
-    Placed placed{{frame.positions.begin(), frame.positions.end()}, rest_};
-    const auto holds = [&](int b) {
-        return b < 0 || frame.bondAlive.empty() || frame.bondAlive[b];
-    };
-    for (const Notch& notch : notches_) {
-        if (!holds(notch.bondP) || !holds(notch.bondN)) continue;
-        placed.x[notch.particle] = 0.5 * (placed.x[notch.p] + placed.x[notch.n]);
-        placed.rest[notch.particle] = 0.5 * (rest_[notch.p] + rest_[notch.n]);
-    }
-    return placed;
-}
-
 /// Writes one frame's mesh: the particles' vertices and their fan copies, two lip vertices per
 /// crossing, then each present triangle's pieces (with their centroid vertices).
 class LatticeSurface::Builder {
 public:
     Builder(const LatticeSurface& surface, const sim::FrameView& frame, const Placed& placed,
             const Cuts& cuts, const Corners& corners, const RenderSettings& settings, Mesh& mesh)
-        : s_(surface),
-          cuts_(cuts),
-          corners_(corners),
-          x_(placed.x),
-          rest_(placed.rest),
-          mesh_(mesh) {
+        : s_(surface), cuts_(cuts), corners_(corners), placed_(placed), mesh_(mesh) {
         colours_ = particleColors(frame, settings);
         const std::vector<Eigen::Vector3f>& colours = colours_;
-        const std::size_t vertices = x_.size() + corners.copyOf.size() + 2 * cuts.edges.size();
+        const std::size_t vertices = placed.size() + corners.copyOf.size() + 2 * cuts.edges.size();
         mesh.positions.reserve(vertices);
         mesh.colors.reserve(vertices);
-        for (std::size_t i = 0; i < x_.size(); ++i) add(x_[i], colours[i]);
-        for (int p : corners.copyOf) add(x_[p], colours[p]);
+        for (int i = 0; i < static_cast<int>(placed.size()); ++i) add(x(i), colours[i]);
+        for (int p : corners.copyOf) add(x(p), colours[p]);
         lipBase_ = static_cast<std::uint32_t>(mesh.positions.size());
         for (std::size_t k = 0; k < cuts.edges.size(); ++k) {
             const auto [i, j] = s_.edges_.ends[cuts.edges[k]];
@@ -409,7 +433,7 @@ public:
             case 1: {  // the slit from the crossing to the centroid
                 const int k = cuts_.broken(side[0]) ? 0 : (cuts_.broken(side[1]) ? 1 : 2);
                 const int a = k, b = (k + 1) % 3, o = (k + 2) % 3;
-                const std::uint32_t g = add(mean(x_, c), mean(colours_, c));
+                const std::uint32_t g = add(meanX(c), mean(colours_, c));
                 mesh_.triangles.push_back({v[a], lip(side[k], c[a]), g});
                 mesh_.triangles.push_back({lip(side[k], c[b]), v[b], g});
                 mesh_.triangles.push_back({v[b], v[o], g});
@@ -427,8 +451,8 @@ public:
                 return;
             }
             default: {  // a junction: one quad per corner, meeting at the centroid
-                const Eigen::Vector3d restCentroid = mean(rest_, c);
-                const Eigen::Vector3d centroid = mean(x_, c);
+                const Eigen::Vector3d restCentroid = (rest(c[0]) + rest(c[1]) + rest(c[2])) / 3.0;
+                const Eigen::Vector3d centroid = meanX(c);
                 const Eigen::Vector3f colour = mean(colours_, c);
                 for (int k = 0; k < 3; ++k) {
                     const std::uint32_t g = add(ownSide(c[k], restCentroid, centroid), colour);
@@ -445,6 +469,12 @@ private:
         return (values[c[0]] + values[c[1]] + values[c[2]]) / typename T::Scalar(3);
     }
 
+    Eigen::Vector3d x(int v) const { return placed_.x(v); }
+    Eigen::Vector3d rest(int v) const { return placed_.rest(v); }
+    Eigen::Vector3d meanX(const std::array<int, 3>& c) const {
+        return (x(c[0]) + x(c[1]) + x(c[2])) / 3.0;
+    }
+
     std::uint32_t add(const Eigen::Vector3d& position, const Eigen::Vector3f& colour) {
         mesh_.positions.push_back(position.cast<float>());
         mesh_.colors.push_back(colour);
@@ -459,7 +489,7 @@ private:
 
     /// The crossing at fraction t of the way from particle a to b, on a's side.
     Eigen::Vector3d lipPosition(int a, int b, double t) {
-        return ownSide(a, (1.0 - t) * rest_[a] + t * rest_[b], (1.0 - t) * x_[a] + t * x_[b]);
+        return ownSide(a, (1.0 - t) * rest(a) + t * rest(b), (1.0 - t) * x(a) + t * x(b));
     }
 
     /// A point of particle a's side, `restTarget` at rest: mapped by the deformation of a's
@@ -469,17 +499,17 @@ private:
     /// towards it, in a's tangent plane.
     Eigen::Vector3d ownSide(int a, const Eigen::Vector3d& restTarget,
                             const Eigen::Vector3d& target) {
-        const Eigen::Vector3d offset = restTarget - rest_[a];
+        const Eigen::Vector3d offset = restTarget - rest(a);
         Eigen::Matrix3d F;
-        if (deformation(a, F) || neighbourDeformation(a, F)) return x_[a] + F * offset;
-        Eigen::Vector3d d = target - x_[a];
+        if (deformation(a, F) || neighbourDeformation(a, F)) return x(a) + F * offset;
+        Eigen::Vector3d d = target - x(a);
         const double reach = offset.norm();
         const double length = d.norm();
         if (length <= reach) return target;
         const Eigen::Vector3d n = wholeNormal(a);
         const Eigen::Vector3d inPlane = d - d.dot(n) * n;
         if (inPlane.norm() > 1e-3 * length) d = inPlane;
-        return x_[a] + reach * d.normalized();
+        return x(a) + reach * d.normalized();
     }
 
     /// The deformation of the first intact neighbour that has one: a particle at a corner of
@@ -504,7 +534,7 @@ private:
     /// neighbours do not span the plane (fewer than two directions).
     bool deformation(int a, Eigen::Matrix3d& F) {
         // Each particle's is fitted once per frame: a particle owns several lip vertices.
-        if (fitted_.empty()) fitted_.assign(x_.size(), kNotFitted);
+        if (fitted_.empty()) fitted_.assign(placed_.size(), kNotFitted);
         int& slot = fitted_[a];
         if (slot == kNotFitted) {
             slot = kNoFit;
@@ -529,8 +559,8 @@ private:
                 if (cuts_.broken(e)) continue;
                 const int j =
                     s_.edges_.ends[e][0] == a ? s_.edges_.ends[e][1] : s_.edges_.ends[e][0];
-                const Eigen::Vector3d restOffset = rest_[j] - rest_[a];
-                moved += (x_[j] - x_[a]) * restOffset.transpose();
+                const Eigen::Vector3d restOffset = rest(j) - rest(a);
+                moved += (x(j) - x(a)) * restOffset.transpose();
                 spread += restOffset * restOffset.transpose();
             }
         }
@@ -552,7 +582,7 @@ private:
             const int t = s_.incident_[k];
             if (!cuts_.present[t] || cuts_.brokenSides[t] > 0) continue;
             const auto& c = s_.triangles_[t];
-            sum += (x_[c[1]] - x_[c[0]]).cross(x_[c[2]] - x_[c[0]]);
+            sum += (x(c[1]) - x(c[0])).cross(x(c[2]) - x(c[0]));
         }
         const double length = sum.norm();
         return length > 0.0 ? Eigen::Vector3d(sum / length) : Eigen::Vector3d::Zero();
@@ -561,8 +591,7 @@ private:
     const LatticeSurface& s_;
     const Cuts& cuts_;
     const Corners& corners_;
-    const std::vector<Eigen::Vector3d>& x_;
-    const std::vector<Eigen::Vector3d>& rest_;
+    const Placed& placed_;
     std::vector<Eigen::Vector3f> colours_;
     Mesh& mesh_;
     std::uint32_t lipBase_ = 0;
@@ -572,7 +601,7 @@ private:
 };
 
 Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& settings) const {
-    const Placed placed = place(frame);
+    const Placed placed(*this, frame);
     Cuts cuts = findCuts(frame);
     placeCrossings(placed, cuts);
     const Corners corners = splitFans(cuts.present, frame.particleCount());

@@ -80,13 +80,7 @@ private:
     };
     class Builder;
 
-    /// One frame's vertex positions and the rest positions they go with, the outline's notch
-    /// particles moved onto the outline while both their outline bonds hold.
-    struct Placed {
-        std::vector<Eigen::Vector3d> x, rest;
-    };
-
-    Placed place(const sim::FrameView& frame) const;
+    class Placed;
     Cuts findCuts(const sim::FrameView& frame) const;
     void placeCrossings(const Placed& placed, Cuts& cuts) const;
     Corners splitFans(const std::vector<std::uint8_t>& present, std::size_t particleCount) const;
@@ -103,6 +97,7 @@ private:
         int particle, p, n, bondP, bondN;
     };
     std::vector<Notch> notches_;
+    std::vector<int> notchOf_;  ///< per particle: its index in notches_, or -1
     std::vector<Eigen::Vector3d> rest_;
     std::vector<Eigen::Vector3d> restNormal_;  ///< unit, area-weighted over the rest triangles
     /// Triangles incident to particle i: incident_[incidentOffsets_[i] .. [i + 1]), ascending.

@@ -19,7 +19,7 @@ namespace rend::render {
 
 /// The cut. A lattice edge is *broken* when its bond (FrameView::bondAlive) is. Each broken edge
 /// has a crossing point in rest coordinates, first its midpoint, then moved along the edge to
-/// where the crack's line through its two neighbouring crossing points meets it (two Jacobi
+/// where the crack's line through its two neighbouring crossing points meets it (four Jacobi
 /// passes; at the sheet's outline or the crack's tip, the line through the next two): a straight
 /// crack gives a straight cut whatever its angle to the lattice, where the midpoints alone
 /// zig-zag at the lattice spacing. Per triangle, by its number of broken sides:

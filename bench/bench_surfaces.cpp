@@ -1,6 +1,8 @@
 // Cost of turning one frame into a surface: ms per frame for the lattice, splat and vdb
 // surfaces on wavy hexagonal sheets of ~11.6K (2 x 2 m) and ~104K (6 x 6 m) particles at
-// dx = 0.02, and ms to export the 11.6K lattice mesh as binary PLY and GLB. Prints only.
+// dx = 0.02, the lattice surface on a torn foil (scenes/foil_tear.toml at frame 150, simulated
+// once at start-up, ~30 s), and ms to export the 11.6K lattice mesh as binary PLY and GLB.
+// Prints only.
 
 #include <benchmark/benchmark.h>
 
@@ -10,6 +12,8 @@
 #include <memory>
 #include <numbers>
 
+#include "app/Pipeline.h"
+#include "app/Scene.h"
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
 #include "render/SplatSurface.h"
@@ -38,6 +42,20 @@ const rend::sim::Membrane& wavySheet(double size) {
     return *sheet;
 }
 
+// scenes/foil_tear.toml at t = 12.5 s (frame 150 at 12 fps): torn through, flaps apart. Built
+// in place: a Membrane's solvers point into it, so it is never moved.
+const rend::sim::Membrane& tornFoil() {
+    const fs::path scenes = fs::path(REND_DEFAULT_ASSETS_DIR).parent_path() / "scenes";
+    static rend::sim::Membrane foil =
+        rend::prepareMembrane(rend::loadScene(scenes / "foil_tear.toml"));
+    static const bool simulated = [] {
+        while (foil.time() < 12.5) foil.step();
+        return true;
+    }();
+    (void)simulated;
+    return foil;
+}
+
 double sheetSize(const benchmark::State& state) { return double(state.range(0)); }
 
 void setCounters(benchmark::State& state, const rend::sim::Membrane& sheet, double triangles) {
@@ -56,6 +74,20 @@ void BM_LatticeSurface(benchmark::State& state) {
         benchmark::DoNotOptimize(mesh.positions.data());
     }
     setCounters(state, sheet, triangles);
+}
+
+void BM_LatticeSurfaceTornFoil(benchmark::State& state) {
+    const auto& foil = tornFoil();
+    const auto frame = foil.view(150);
+    const rend::render::LatticeSurface surface(frame);
+    double triangles = 0;
+    for (auto _ : state) {
+        const auto mesh = surface.build(frame, RenderSettings{});
+        triangles = double(mesh.triangles.size());
+        benchmark::DoNotOptimize(mesh.positions.data());
+    }
+    setCounters(state, foil, triangles);
+    state.counters["broken_bonds"] = double(foil.brokenBondCount());
 }
 
 void BM_SplatSurface(benchmark::State& state) {
@@ -100,6 +132,7 @@ void BM_ExportLattice(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_LatticeSurface)->Arg(2)->Arg(6)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LatticeSurfaceTornFoil)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SplatSurface)->Arg(2)->Arg(6)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_VdbSurface)->Arg(2)->Arg(6)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ExportLattice)

@@ -1,67 +1,105 @@
 #pragma once
-// The `lattice` surface: the rest lattice triangulated once (FrameView::restTriangles);
-// per frame a triangle is dropped when the bond along one of its edges is broken, and the
-// vertices along cracks are duplicated so that the surface opens there.
+// The `lattice` surface: the rest lattice triangulated once (FrameView::restTriangles) and cut,
+// per frame, along the lattice edges whose bonds broke, as marching triangles cut a triangle
+// along an iso-line: each broken edge gets a crossing point, and each triangle is split into the
+// pieces on either side of the crack through it. So cracks are cut where the bonds broke, with
+// smooth lips that open as the particles separate, instead of dropping whole triangles.
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "render/Mesh.h"
 #include "render/RenderSettings.h"
+#include "render/RestTopology.h"
 #include "sim/FrameView.h"
 
 namespace rend::render {
 
-/// Vertex duplication along cracks. Around each particle, its kept triangles fall into *fans*:
-/// groups connected through shared edges (two kept triangles that share an edge share an
-/// intact bond, so they belong to the same piece of material there). The first fan (the one
-/// holding the particle's lowest-numbered kept triangle) uses the particle's own vertex; every
-/// further fan gets a copy with the same position and colour. Normals are averaged per vertex,
-/// so they never blend across a crack, and two fragments touching at one particle (a bowtie)
-/// share no vertex. Vertices [0, particleCount) are the particles, in order, so an intact
-/// sheet gives exactly the mesh it gave before cracks were handled; copies follow.
+/// The cut. A lattice edge is *broken* when its bond (FrameView::bondAlive) is. Each broken edge
+/// has a crossing point in rest coordinates, first its midpoint, then moved along the edge to
+/// where the crack's line through its two neighbouring crossing points meets it (four Jacobi
+/// passes; at the sheet's outline or the crack's tip, the line through the next two): a straight
+/// crack gives a straight cut whatever its angle to the lattice, where the midpoints alone
+/// zig-zag at the lattice spacing. Per triangle, by its number of broken sides:
+/// - none: kept whole;
+/// - one (the crack's tip, or a lone broken bond): a slit from the crossing point to the
+///   centroid; the triangle stays one piece, so a lone broken bond leaves no hole;
+/// - two: the corner between them becomes a triangle, the other two corners a quad;
+/// - three (a crack junction): three quads, one per corner, meeting at the centroid.
+/// Every crossing point has two vertices, one for each end of its edge, and each piece takes
+/// the one of its own corner, so the two lips of a crack are separate and no triangle bridges
+/// it. A lip vertex lies at its rest distance from its particle, towards the other end and in
+/// its particle's tangent plane, so a lip keeps the particle's side's shape and the crack opens
+/// by exactly how far the particles moved apart beyond their rest length. Pieces connect
+/// exactly where lattice edges are intact, so a fully separated sheet falls into pieces.
 ///
-/// The per-particle triangle lists and the triangle-edge adjacency are built once; a frame
-/// only recomputes which triangles are kept and walks each particle's fans: O(triangles).
+/// Triangles that FrameView::keptTriangles drops with no broken side (the FEM's element
+/// erosion) or that FrameView::triangleAlive says were removed are dropped whole. Around each
+/// particle the remaining triangles fall into *fans* connected through shared sides; the first
+/// fan (the one holding the particle's lowest-numbered triangle) uses the particle's own
+/// vertex, every further fan a copy, so two pieces touching at one particle (a bowtie) share no
+/// vertex. A cut never splits a fan: around a particle, consecutive pieces always share at
+/// least the half of their common edge on the particle's side.
+///
+/// The outline: notch particles of the rest outline (RestTopology's outlineNotches) are drawn
+/// at the midpoint of their two outline neighbours while both outline bonds hold, so an intact
+/// rectangle of hexagonal lattice has straight sides. Vertices [0, particleCount) are the
+/// particles, in order (at the particles' positions but for those notches); fan copies, lip
+/// vertices and centroids follow. An intact sheet has no extra vertex.
+///
+/// Everything per frame is a pass over the triangles and edges: O(triangles).
 class LatticeSurface {
 public:
-    /// Builds the triangles around each particle and the edge adjacency once.
+    /// Builds the edge maps, the triangles around each particle and the outline notches once.
     explicit LatticeSurface(const sim::FrameView& rest);
 
-    /// The frame's kept triangles (FrameView::keptTriangles), with vertices duplicated along
-    /// cracks (see above), smooth (area-weighted) normals per vertex and per-vertex colours from
-    /// the settings' ColorBy.
+    /// The frame's mesh (cut as above), smooth (area-weighted) normals per vertex, which never
+    /// blend across a crack, and per-vertex colours from the settings' ColorBy, interpolated
+    /// along the edge at lip vertices and averaged at centroids.
     ///
     /// With settings.thickness > 0 the sheet becomes a solid: the mesh above, offset by
     /// +thickness/2 along the vertex normals (same vertex indices, so vertices
     /// [0, particleCount) are still the particles), a copy offset by -thickness/2 facing the
     /// other way (indices + the sheet's vertex count), then walls along every edge used by a
-    /// single kept triangle, with their own vertices and outward normals, so the outline and
-    /// both lips of every crack show as walls. Welding coincident vertices makes it closed.
+    /// single triangle, with their own vertices and outward normals, so the outline and both
+    /// lips of every crack show as walls. Welding coincident vertices makes it closed.
     /// Large thicknesses on sharply folded sheets self-intersect: it is an offset, not a CSG.
     Mesh build(const sim::FrameView& frame, const RenderSettings& settings) const;
 
-    /// Indices into FrameView::restTriangles of the triangles kept in this frame.
+    /// Indices into FrameView::restTriangles of the triangles kept in this frame
+    /// (FrameView::keptTriangles: none of their sides broken, not removed).
     std::vector<int> keptTriangles(const sim::FrameView& frame) const;
 
 private:
-    /// A triangle's mesh vertex per corner, plus the particle each appended copy stands for.
+    struct Cuts;
     struct Corners {
         std::vector<std::array<std::uint32_t, 3>> vertex;  ///< per rest triangle
         std::vector<int> copyOf;                           ///< particle of vertex particleCount + k
     };
+    class Builder;
 
-    std::vector<std::uint8_t> keptFlags(const sim::FrameView& frame) const;
-    Corners splitFans(const std::vector<std::uint8_t>& kept, std::size_t particleCount) const;
+    class Placed;
+    Cuts findCuts(const sim::FrameView& frame) const;
+    void placeCrossings(const Placed& placed, Cuts& cuts) const;
+    Corners splitFans(const std::vector<std::uint8_t>& present, std::size_t particleCount) const;
     void walkFan(int start, int particle, std::uint32_t vertex,
-                 const std::vector<std::uint8_t>& kept, Corners& corners,
+                 const std::vector<std::uint8_t>& present, Corners& corners,
                  std::vector<int>& stack) const;
     int cornerOf(int triangle, int particle) const;
 
     std::vector<std::array<int, 3>> triangles_;
-    /// Triangle across edge e (corners e, e+1) of each triangle; -1 on the rest boundary.
-    std::vector<std::array<int, 3>> edgeNeighbours_;
+    RestEdges edges_;
+    std::vector<int> edgeBond_;  ///< bond ends[0] -> ends[1] of each edge, or -1
+    /// An outline notch: the particle, its outline neighbours and the bonds to them.
+    struct Notch {
+        int particle, p, n, bondP, bondN;
+    };
+    std::vector<Notch> notches_;
+    std::vector<int> notchOf_;  ///< per particle: its index in notches_, or -1
+    std::vector<Eigen::Vector3d> rest_;
+    std::vector<Eigen::Vector3d> restNormal_;  ///< unit, area-weighted over the rest triangles
     /// Triangles incident to particle i: incident_[incidentOffsets_[i] .. [i + 1]), ascending.
     std::vector<int> incidentOffsets_;
     std::vector<int> incident_;

@@ -37,6 +37,11 @@ struct FrameView {
     /// means every triangle is kept.
     std::span<const std::uint8_t> keptTriangles;
 
+    /// Per rest triangle, 0 once removed (the FEM's element erosion), whatever its edges; empty
+    /// means none is. It tells a removed triangle from one whose edges broke, which the lattice
+    /// surface cuts rather than drops.
+    std::span<const std::uint8_t> triangleAlive;
+
     bool triangleKept(std::size_t t) const { return keptTriangles.empty() || keptTriangles[t]; }
 
     std::size_t particleCount() const { return positions.size(); }

@@ -291,6 +291,7 @@ FrameView Membrane::view(int frame) const {
     v.bondRestLength = bonds_.restLength;
     v.bondAlive = damageState_.bondAlive();
     v.keptTriangles = damageState_.keptTriangles();
+    v.triangleAlive = damageState_.triangleAlive();
     return v;
 }
 

@@ -64,7 +64,8 @@ struct Sheet {
                 .bondPartners = partners,
                 .bondRestLength = restLength,
                 .bondAlive = alive,
-                .keptTriangles = kept};
+                .keptTriangles = kept,
+                .triangleAlive = {}};
     }
 
     /// Breaks the bond a-b from both ends, and drops the triangles along it as the

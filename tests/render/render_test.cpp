@@ -112,12 +112,13 @@ TEST(Surfaces, AnErodedFemElementAppearsInNoSurface) {
     EXPECT_EQ(std::size_t(std::count(splat.begin(), splat.end(), 1)), total - 1);
 }
 
-TEST(LatticeSurface, BuiltMeshReferencesOnlyKeptTriangles) {
+TEST(LatticeSurface, BuiltMeshSlitsBothTrianglesAlongABrokenBond) {
     GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
     const auto mesh = surface.build(sheet.view(), RenderSettings{});
-    EXPECT_EQ(mesh.triangles.size(), sheet.triangles.size() - 2);
+    // Each of the two becomes four triangles around its centroid, the slit between two of them.
+    EXPECT_EQ(mesh.triangles.size(), sheet.triangles.size() - 2 + 8);
     EXPECT_EQ(mesh.positions.size(), mesh.normals.size());
     EXPECT_EQ(mesh.positions.size(), mesh.colors.size());
     for (const auto& t : mesh.triangles)
@@ -136,8 +137,10 @@ TEST(LatticeSurface, NormalsOfAFlatSheetAtRestAreUnitAndPointUp) {
 TEST(LatticeSurface, IsolatedVertexGetsTheUpNormal) {
     GridSheet sheet(3, 3, 1.0);
     const LatticeSurface surface(sheet.view());
-    // Cutting every bond of the corner particle leaves it referenced by no triangle.
-    for (int b = sheet.offsets[0]; b < sheet.offsets[1]; ++b) sheet.breakBond(0, sheet.partners[b]);
+    // Removing the corner particle's one triangle (as erosion does) leaves it in none.
+    sheet.kept.assign(sheet.triangles.size(), 1);
+    for (std::size_t t = 0; t < sheet.triangles.size(); ++t)
+        if (std::count(sheet.triangles[t].begin(), sheet.triangles[t].end(), 0)) sheet.kept[t] = 0;
     sheet.positions[0].z() = 5.0;
     const auto mesh = surface.build(sheet.view(), RenderSettings{});
     EXPECT_TRUE(mesh.normals[0].isApprox(Eigen::Vector3f::UnitZ()));
@@ -145,24 +148,15 @@ TEST(LatticeSurface, IsolatedVertexGetsTheUpNormal) {
 
 namespace {
 
-// Breaks every bond that is not an edge of a triangle of a kept cell, so exactly those cells'
-// triangles survive.
+// Removes (as erosion does, bonds intact) the triangles of every cell not kept.
 template <typename KeepCell>
 void keepOnlyCells(GridSheet& sheet, KeepCell keep) {
-    std::set<std::pair<int, int>> edges;
-    for (int j = 0; j + 1 < sheet.ny; ++j) {
-        for (int i = 0; i + 1 < sheet.nx; ++i) {
-            if (!keep(i, j)) continue;
-            for (int t : {2 * (j * (sheet.nx - 1) + i), 2 * (j * (sheet.nx - 1) + i) + 1}) {
-                const auto& tri = sheet.triangles[t];
-                for (int e = 0; e < 3; ++e) edges.insert(std::minmax(tri[e], tri[(e + 1) % 3]));
-            }
-        }
-    }
-    for (int a = 0; a < static_cast<int>(sheet.positions.size()); ++a)
-        for (int b = sheet.offsets[a]; b < sheet.offsets[a + 1]; ++b)
-            if (!edges.count(std::minmax(a, sheet.partners[b])))
-                sheet.breakBond(a, sheet.partners[b]);
+    sheet.kept.assign(sheet.triangles.size(), 1);
+    for (int j = 0; j + 1 < sheet.ny; ++j)
+        for (int i = 0; i + 1 < sheet.nx; ++i)
+            if (!keep(i, j))
+                for (int t : {2 * (j * (sheet.nx - 1) + i), 2 * (j * (sheet.nx - 1) + i) + 1})
+                    sheet.kept[t] = 0;
 }
 
 // Union-find over mesh vertices joined by triangles; returns each triangle's component root.
@@ -198,13 +192,13 @@ TEST(LatticeSurfaceCracks, IntactSheetHasNoExtraVertices) {
     EXPECT_EQ(triangleComponents(mesh).size(), sheet.triangles.size());
 }
 
-TEST(LatticeSurfaceCracks, SlitEndingInsideTheSheetAddsNoVertex) {
-    // One broken bond opens a slit, but every particle's kept triangles still form one fan.
+TEST(LatticeSurfaceCracks, SlitEndingInsideTheSheetAddsTwoLipVerticesAndTwoCentroids) {
+    // One broken bond opens a slit; every particle's triangles still form one fan.
     GridSheet sheet(6, 5, 1.0);
     const LatticeSurface surface(sheet.view());
     sheet.breakBond(sheet.id(2, 2), sheet.id(3, 2));
     EXPECT_EQ(surface.build(sheet.view(), RenderSettings{}).positions.size(),
-              sheet.positions.size());
+              sheet.positions.size() + 4);
 }
 
 TEST(LatticeSurfaceCracks, BowtieParticleGetsExactlyOneCopy) {
@@ -239,21 +233,20 @@ TEST(LatticeSurfaceCracks, BowtieParticleGetsExactlyOneCopy) {
 }
 
 TEST(LatticeSurfaceCracks, SheetCutFullyAcrossFallsIntoTwoPiecesSharingNoVertex) {
-    // Break every bond crossing the anti-diagonal line i + j = n - 1, which runs through
-    // particles: the two halves touch at each of the n - 2 interior particles on the line.
+    // Break every bond crossing the anti-diagonal line i + j = n - 1.5, between particles. (A
+    // line through particles would leave them bonded to both sides: no separation.)
     constexpr int n = 7;
     GridSheet sheet(n, n, 1.0);
     const LatticeSurface surface(sheet.view());
-    auto side = [&](int p) { return (p % n + p / n > n - 1) - (p % n + p / n < n - 1); };
+    auto side = [&](int p) { return p % n + p / n > n - 1.5 ? 1 : -1; };
     for (int a = 0; a < n * n; ++a)
         for (int b = sheet.offsets[a]; b < sheet.offsets[a + 1]; ++b)
             if (side(a) * side(sheet.partners[b]) < 0) sheet.breakBond(a, sheet.partners[b]);
     // Tilt the upper half about the crack; the lower half stays flat.
     for (int p = 0; p < n * n; ++p)
-        if (side(p) > 0) sheet.positions[p].z() = 0.5 * (p % n + p / n - (n - 1));
+        if (side(p) > 0) sheet.positions[p].z() = 0.5 * (p % n + p / n - (n - 1.5));
     const auto mesh = surface.build(sheet.view(), RenderSettings{});
     expectIndicesInRange(mesh);
-    EXPECT_EQ(mesh.positions.size(), sheet.positions.size() + (n - 2));
 
     const std::vector<int> roots = triangleComponents(mesh);
     const std::set<int> components(roots.begin(), roots.end());

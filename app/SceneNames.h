@@ -22,8 +22,9 @@ inline constexpr std::string_view kSurfaces[] = {"lattice", "splat", "vdb"};
 inline constexpr std::string_view kMaterials[] = {"diffuse", "conductor", "film", "translucent"};
 inline constexpr std::string_view kExportFormats[] = {"ply", "obj", "glb", "vdb"};
 inline constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "theta", "damage"};
-/// The words that stand for "no number": dt = "auto", fracture_energy = "none".
-inline constexpr std::string_view kAuto[] = {"auto"};
+/// The words that stand for "no number": dt = "adaptive" or "auto", fracture_energy = "none".
+/// dt's first word is its default (sim::StepControl in this order, reversed).
+inline constexpr std::string_view kStepWords[] = {"adaptive", "auto"};
 inline constexpr std::string_view kNone[] = {"none"};
 
 /// Index of `name` in `table`, if it is there.

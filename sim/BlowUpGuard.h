@@ -92,6 +92,7 @@ private:
     [[noreturn]] void report(const State& state, const Sample& s, const std::string& why) const;
     void addWork(const State& state, const Sample& s);
 
+    TimeParams time_;  ///< how the step is chosen, for the advice
     double speedLimit_ = kLightSpeed;
     Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
     bool hasGravity_ = false;

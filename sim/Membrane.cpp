@@ -142,7 +142,8 @@ void Membrane::kick(double h, double tNext) {
 }
 
 void Membrane::checkFinite() {
-    guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_},
+    guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
+                  adaptiveStep_},
                  [this] { return kineticEnergy() + strainEnergy(); });
 }
 
@@ -284,7 +285,9 @@ void Membrane::advanceTo(double tEnd) {
         const double pieces = std::ceil(left / wanted * (1.0 - 1e-12));
         dt_ = pieces <= 1.0 ? left : left / pieces;
         const std::size_t before = breakCount();
+        adaptiveStep_ = true;
         step();
+        adaptiveStep_ = false;
         if (pieces <= 1.0) time_ = tEnd;  // exactly, whatever the rounding of time_ + dt_
         controller_.record(dt_, breakCount() - before, criticalStretchRate());
     }

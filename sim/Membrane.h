@@ -176,6 +176,7 @@ private:
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     TimeStepController controller_;
     double criticalStretch_ = std::numeric_limits<double>::infinity();
+    bool adaptiveStep_ = false;  ///< step() runs inside advanceTo (the guard's advice)
     double dtMin_ = std::numeric_limits<double>::infinity(), dtMax_ = 0.0;
     static constexpr int kMaxPieces = 64;
 

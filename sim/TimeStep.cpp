@@ -3,6 +3,13 @@
 #include <algorithm>
 
 namespace rend::sim {
+namespace {
+
+/// No limit cuts a step below this fraction of safety x the bound: a bond whose strength is all
+/// but gone, or bursts in a row, cannot stall a run (the same floor as the power law's pieces).
+constexpr double kSmallest = 1.0 / 64;
+
+}  // namespace
 
 TimeStepController::TimeStepController(const TimeParams& time)
     : safety_(time.safety),
@@ -20,6 +27,7 @@ double TimeStepController::next(double stableDt) {
         dt = cap_;
         limit = burst_ ? StepLimit::Burst : StepLimit::Growth;
     }
+    dt = std::max(dt, kSmallest * safety_ * stableDt);
     wanted_ = dt;
     lastLimit_ = limit;
     ++counts_[int(limit)];

@@ -8,11 +8,12 @@
 //              max_stretch_increment / max |ds/dt|, no intact bond's stretch s jumps far
 //              burst cap)                           a step that broke many bonds shrinks the next
 //
-// and never grows by more than kGrowth over the step before. The bound is the rest one over the
-// square root of the solver's stiffening (the power law in compression), recomputed every step.
-// The stretch rate is measured on the Membrane's bond families (every particle pair within the
-// cutoff R), which every solver has, so the same limit serves the bonds, the elements, the
-// springs and SPH alike; breaks are the DamageState's broken bonds and removed triangles.
+// and never grows by more than kGrowth over the step before, nor falls below 1/64 of safety x
+// bound. The bound is the rest one over the square root of the solver's stiffening (the power law
+// in compression), recomputed every step. The stretch rate is measured on the Membrane's bond
+// families (every particle pair within the cutoff R), which every solver has, so the same limit
+// serves the bonds, the elements, the springs and SPH alike; breaks are the DamageState's broken
+// bonds and removed triangles.
 //
 // Inputs are a maximum and counts, which no thread count changes: the steps, and so the run,
 // are bitwise identical for any number of threads.

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <string>
 #include <tuple>
 
 #include "sim/Membrane.h"
@@ -129,6 +131,33 @@ TEST(AdaptiveStep, OneAndTwoThreadsGiveIdenticalBits) {
     EXPECT_EQ(std::memcmp(x1.data(), x2.data(), x1.size() * sizeof(x1[0])), 0);
     EXPECT_EQ(alive1, alive2);
     EXPECT_GT(std::count(alive1.begin(), alive1.end(), 0), 0) << "it tore";
+}
+
+TEST(AdaptiveStep, ABlowUpAdvisesALowerSafetyOrAFixedStep) {
+    MembraneParams p = tearingSheet();
+    p.time.safety = 0.7;
+    Membrane m(p);
+    m.advanceTo(0.1);
+    const int free = m.nearestParticle({0.2, 0.2});  // away from the grips
+    m.velocities()[free].x() = std::numeric_limits<double>::quiet_NaN();
+    try {
+        m.advanceTo(0.2);
+        FAIL() << "the guard let a NaN through";
+    } catch (const NumericalBlowUp& e) {
+        EXPECT_EQ(e.particle, free);
+        const std::string message = e.what();
+        EXPECT_NE(message.find("lower time.safety (now 0.7) or use a fixed dt <= "),
+                  std::string::npos)
+            << message;
+    }
+    Membrane fixed(p);  // step() alone is a fixed step: the usual advice
+    fixed.velocities()[free].x() = std::numeric_limits<double>::quiet_NaN();
+    try {
+        fixed.step();
+        FAIL() << "the guard let a NaN through";
+    } catch (const NumericalBlowUp& e) {
+        EXPECT_EQ(std::string(e.what()).find("time.safety"), std::string::npos) << e.what();
+    }
 }
 
 TEST(AdaptiveStep, MeasuresStretchOnlyOnBondsLoadedTowardsBreaking) {

@@ -171,8 +171,15 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"scene\": " << jsonString(scene.file.string()) << ",\n"
       << "  \"status\": " << jsonString(status) << ",\n"
       << "  \"particles\": " << s.particles << ",\n  \"bonds\": " << s.bonds << ",\n"
-      << "  \"dt\": " << s.dt << ",\n  \"stable_dt\": " << s.stableDt << ",\n"
-      << "  \"substeps_per_frame\": " << s.substeps << ",\n  \"steps\": " << s.steps << ",\n"
+      << "  \"time_step\": " << jsonString(s.stepControl) << ",\n"
+      << "  \"dt\": " << s.dt << ",\n  \"dt_min\": " << s.dtMin << ",\n  \"dt_max\": " << s.dtMax
+      << ",\n  \"stable_dt\": " << s.stableDt << ",\n"
+      << "  \"substeps_per_frame\": " << (s.substeps > 0 ? std::to_string(s.substeps) : "null")
+      << ",\n  \"steps\": " << s.steps << ",\n"
+      << "  \"steps_limited_by\": {\"bound\": " << s.limitedBy[0]
+      << ", \"stretch\": " << s.limitedBy[1] << ", \"burst\": " << s.limitedBy[2]
+      << ", \"growth\": " << s.limitedBy[3] << "},\n"
+      << "  \"largest_burst\": " << s.largestBurst << ",\n"
       << "  \"extra_substeps\": " << s.extraSubsteps << ",\n"
       << "  \"frames_simulated\": " << s.framesSimulated << ",\n"
       << "  \"frames_written\": " << s.framesWritten << ",\n"
@@ -316,13 +323,17 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     RunSummary s;
     auto t0 = Clock::now();
     sim::Membrane membrane = prepareMembrane(scene);
-    const auto [substeps, dt] = substepsPerFrame(membrane.timeStep(), scene.sim.time.fps);
-    membrane.setTimeStep(dt);
+    const sim::TimeParams& time = scene.sim.time;
+    const bool adaptive = time.adaptive();
+    // A fixed step is evened out to divide the frame; adaptive steps land on frames themselves.
+    const auto [substeps, dt] = substepsPerFrame(membrane.timeStep(), time.fps);
+    if (!adaptive) membrane.setTimeStep(dt);
     s.particles = membrane.particleCount();
     s.bonds = membrane.bondCount();
-    s.dt = dt;
+    s.stepControl = time.dt ? "fixed" : adaptive ? "adaptive" : "auto";
+    s.dt = s.dtMin = s.dtMax = adaptive ? 0.0 : dt;
     s.stableDt = membrane.stableTimeStep();
-    s.substeps = substeps;
+    s.substeps = adaptive ? 0 : substeps;
     std::fprintf(stderr, "estimate: %s\n", describeEstimate(estimateRun(scene, membrane)).c_str());
     const int frames = scene.frameCount();
     const auto [first, last] = options.frames.value_or(std::pair{1, frames});
@@ -345,6 +356,14 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     auto finish = [&](const std::string& status) {
         s.steps = membrane.stepCount();
         s.extraSubsteps = membrane.extraSubsteps();
+        if (adaptive && s.steps > 0) {
+            s.dt = membrane.time() / double(s.steps);
+            s.dtMin = membrane.smallestTimeStep();
+            s.dtMax = membrane.largestTimeStep();
+            std::copy_n(membrane.stepController().limitCounts(), s.limitedBy.size(),
+                        s.limitedBy.begin());
+            s.largestBurst = membrane.stepController().largestBurst();
+        }
         if (s.steps > 0)
             s.nsPerParticleStep = s.seconds.simulate * 1e9 / (double(s.steps) * s.particles);
         if (stats && stats->finish()) folder.wrote({"stats.csv"});
@@ -367,7 +386,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     try {
         for (int frame = 1; frame <= last; ++frame) {
             t0 = Clock::now();
-            for (int k = 0; k < substeps; ++k) membrane.step();
+            if (adaptive)
+                membrane.advanceTo(frame / time.fps);
+            else
+                for (int k = 0; k < substeps; ++k) membrane.step();
             s.seconds.simulate += secondsSince(t0);
             s.framesSimulated = frame;
             const StatsWriter::Row row = frameStats(frame, membrane);  // checks it is finite

@@ -2,6 +2,7 @@
 // `rend run` and `rend check`: scene -> Membrane -> FrameView -> surface -> renderer -> PNG,
 // plus stats.csv and run.json. Stages run only when an output needs them.
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -30,9 +31,14 @@ struct StageTimes {
 struct RunSummary {
     int particles = 0;
     std::size_t bonds = 0;
-    double dt = 0.0;
+    std::string stepControl;  ///< "fixed", "auto" or "adaptive"
+    double dt = 0.0;          ///< the fixed step, or the adaptive steps' mean
+    double dtMin = 0.0, dtMax = 0.0;
     double stableDt = 0.0;
-    int substeps = 0;  ///< explicit steps per frame
+    int substeps = 0;  ///< explicit steps per frame; 0 for adaptive steps
+    /// Adaptive: steps each limit chose (bound, stretch, burst, growth; sim::StepLimit order).
+    std::array<long, 4> limitedBy{};
+    std::size_t largestBurst = 0;  ///< adaptive: the most bonds one step broke
     long steps = 0;
     long extraSubsteps = 0;  ///< pieces the power law's stiffening cut steps into, beyond steps
     int framesSimulated = 0;

@@ -432,7 +432,12 @@ void readTime(const TableReader& root, Scene& scene) {
     const TableReader t = root.section("time");
     sim::TimeParams& time = scene.sim.time;
     time.dt = t.numberOrWord("dt", time.dt);
+    if (const toml::node* dt = t.find("dt"); dt && dt->as_string())
+        time.control =
+            dt->as_string()->get() == "auto" ? sim::StepControl::Auto : sim::StepControl::Adaptive;
     time.safety = t.number("safety").value_or(time.safety);
+    time.maxStretchIncrement = t.number("max_stretch_increment").value_or(time.maxStretchIncrement);
+    time.burstBonds = int(t.integer("burst_bonds").value_or(time.burstBonds));
     time.duration = t.number("duration").value_or(time.duration);
     time.fps = t.number("fps").value_or(time.fps);
     time.allowUnstable = t.boolean("allow_unstable").value_or(time.allowUnstable);

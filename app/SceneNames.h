@@ -25,8 +25,9 @@ inline constexpr std::string_view kColorModes[] = {"none", "speed", "strain", "t
 inline constexpr std::string_view kLooks[] = {"plain", "foil", "film", "seaweed", "paper"};
 inline constexpr std::string_view kThetaStyles[] = {"layer", "paper_map"};
 inline constexpr std::string_view kToneMaps[] = {"filmic", "clamp"};
-/// The words that stand for "no number": dt = "auto", fracture_energy = "none".
-inline constexpr std::string_view kAuto[] = {"auto"};
+/// The words that stand for "no number": dt = "adaptive" or "auto", fracture_energy = "none".
+/// dt's first word is its default (sim::StepControl in this order, reversed).
+inline constexpr std::string_view kStepWords[] = {"adaptive", "auto"};
 inline constexpr std::string_view kNone[] = {"none"};
 
 /// Index of `name` in `table`, if it is there.

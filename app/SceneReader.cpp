@@ -405,12 +405,15 @@ std::optional<double> TableReader::numberOrWord(std::string_view key,
     const toml::node* node = find(key);
     if (!node) return fallback;
     const Param& p = param(key);
-    const std::string_view word = p.names.front();
-    if (const auto* text = node->as_string(); text && text->get() == word) return std::nullopt;
+    if (const auto* text = node->as_string();
+        text && std::find(p.names.begin(), p.names.end(), text->get()) != p.names.end())
+        return std::nullopt;
     if (node->is_number()) return number(key);
-    const std::string orWord = " or " + std::string(p.key) + " = " + quoteText(word) + ".";
-    fail(key,
-         expectedNumber(p, "a number") + " (" + std::string(p.meaning) + ") or " + quoteText(word),
+    std::string words;
+    for (std::size_t k = 0; k < p.names.size(); ++k)
+        words += (k == 0 ? "" : " or ") + quoteText(p.names[k]);
+    const std::string orWord = " or " + std::string(p.key) + " = " + words + ".";
+    fail(key, expectedNumber(p, "a number") + " (" + std::string(p.meaning) + ") or " + words,
          describeType(*node), useInstead(key).substr(0, useInstead(key).size() - 1) + orWord);
 }
 

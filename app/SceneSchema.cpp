@@ -261,10 +261,20 @@ constexpr Param kForces[] = {
 };
 
 constexpr Param kTimeKeys[] = {
-    {"dt", T::NumberOrWord, positive(10.0), "\"auto\" (safety x the stable bound)",
-     "the time step in seconds", "1e-4", names::kAuto},
+    {"dt", T::NumberOrWord, positive(10.0), "\"adaptive\" (see the README's time step)",
+     "the time step in seconds (fixed); \"auto\": safety x the stable bound, fixed; "
+     "\"adaptive\": safety x the current bound, cut where bonds stretch fast or break in bursts",
+     "3e-4", names::kStepWords},
     {"safety", T::Number, Range::openClosed(0.0, 1.0), "0.8",
-     "the fraction of the stable time step used by dt = \"auto\"", "0.8"},
+     "the fraction of the stable time step used by dt = \"auto\" and \"adaptive\"", "0.8"},
+    {"max_stretch_increment", T::Number, Range::openClosed(0.0, 1.0), "0.02",
+     "adaptive dt: the most a bond loaded past half its critical stretch may stretch in one "
+     "step, as a fraction of the critical stretch",
+     "0.05"},
+    {"burst_bonds", T::Integer, closed(1, 1e6), "8",
+     "adaptive dt: a step that breaks more bonds shrinks the next (by the excess, regrowing "
+     "1.25x per step)",
+     "4"},
     {"duration", T::Number, positive(1e6), "5", "the simulated time in seconds", "5.0"},
     {"fps", T::Number, closed(1e-3, 1e4), "24", "the output frames per simulated second", "24"},
     {"allow_unstable",
@@ -447,7 +457,7 @@ std::string typeText(const Param& p) {
         case T::Choice:
             return quotedNames(p.names);
         case T::NumberOrWord:
-            return "number" + within + " or `\"" + std::string(p.names[0]) + "\"`";
+            return "number" + within + " or " + quotedNames(p.names);
         case T::Vec2:
             return "[x, y]" + within;
         case T::Vec3:

@@ -39,14 +39,16 @@ int checkCommand(const std::string& file, const std::vector<std::string>& sets) 
     const auto [substeps, dt] = rend::substepsPerFrame(membrane.timeStep(), scene.sim.time.fps);
     const rend::RunEstimate estimate = rend::estimateRun(scene, membrane);
     const rend::SheetEstimate sheet = rend::estimateSheet(scene.sim.sheet);
+    const bool adaptive = scene.sim.time.adaptive();  // steps of at most dt, more where needed
     std::printf(
-        "%s: ok\n  %d particles, %zu bonds, dt %.4g s (stable limit %.4g s), "
-        "%d steps per frame, %d frames\n"
+        "%s: ok\n  %d particles, %zu bonds, dt %s%.4g s (stable limit %.4g s), "
+        "%s%d steps per frame, %d frames\n"
         "  estimated memory %.3g GB (%.3g particles x (%g B + %.3g bonds x %g B))\n"
         "  estimated cost: %s\n",
-        file.c_str(), membrane.particleCount(), membrane.bondCount(), dt, membrane.stableTimeStep(),
-        substeps, scene.frameCount(), sheet.bytes / 1e9, sheet.particles,
-        rend::SheetEstimate::kBytesPerParticle, sheet.bondsPerParticle,
+        file.c_str(), membrane.particleCount(), membrane.bondCount(),
+        adaptive ? "adaptive, at most " : "", dt, membrane.stableTimeStep(),
+        adaptive ? "at least " : "", substeps, scene.frameCount(), sheet.bytes / 1e9,
+        sheet.particles, rend::SheetEstimate::kBytesPerParticle, sheet.bondsPerParticle,
         rend::SheetEstimate::kBytesPerBondEnd, rend::describeEstimate(estimate).c_str());
     return 0;
 }

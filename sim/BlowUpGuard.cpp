@@ -30,7 +30,8 @@ namespace {
 /// forces themselves put in (a non-conservative solver, a power-law sheet crushed flat).
 constexpr double kWellBelowBound = 0.25;
 
-void adviseOn(std::ostream& out, double dt, double stableDt, double suggested) {
+void adviseOn(std::ostream& out, double dt, double stableDt, double suggested, bool adaptive,
+              double safety) {
     if (dt <= kWellBelowBound * stableDt) {
         out << " The time step " << dt << " s is already " << std::setprecision(2) << stableDt / dt
             << std::setprecision(6)
@@ -42,6 +43,13 @@ void adviseOn(std::ostream& out, double dt, double stableDt, double suggested) {
     }
     out << " The time step " << dt << " s against the stable limit " << stableDt
         << " s is the usual cause; ";
+    if (adaptive) {
+        // The adaptive step follows the bound: a smaller safety scales every step down.
+        out << "lower time.safety (now " << safety << ") or use a fixed dt";
+        if (suggested > 0.0) out << " <= " << suggested;
+        out << ", or slow the boundary velocities, gravity or pressure.";
+        return;
+    }
     if (suggested > 0.0)
         out << "use dt <= " << suggested << " (or dt = \"auto\")";
     else
@@ -61,6 +69,7 @@ BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
     const double waveSpeed = capped(params.sheet.dx * std::sqrt(worstRatio), kLightSpeed);
     const double fall =
         capped(params.gravity.norm(), kLightSpeed) * capped(params.time.duration, kLightSpeed);
+    safety_ = params.time.safety;
     speedLimit_ = capped(100.0 * waveSpeed + 10.0 * boundarySpeed + 2.0 * fall + 1e-6, kLightSpeed);
 
     gravity_ = params.gravity.allFinite() ? params.gravity : Eigen::Vector3d::Zero();
@@ -183,7 +192,7 @@ void BlowUpGuard::report(const State& state, const Sample& s, const std::string&
             << " m/s.";
     else
         out << " at " << speed << " m/s.";
-    adviseOn(out, state.dt, state.stableDt, suggested);
+    adviseOn(out, state.dt, state.stableDt, suggested, state.adaptive, safety_);
     throw NumericalBlowUp(out.str(), state.step, culprit, suggested);
 }
 

@@ -66,6 +66,7 @@ public:
         std::span<const std::int16_t> constraint;
         long step = 0;
         double time = 0.0, dt = 0.0, stableDt = 0.0;
+        bool adaptive = false;  ///< the step came from the adaptive controller (sim/TimeStep.h)
     };
     /// Checks the state after a step; throws NumericalBlowUp naming the step, the fastest (or
     /// first non-finite) particle and a suggested dt. `totalEnergy` (kinetic + strain) is
@@ -92,6 +93,7 @@ private:
     [[noreturn]] void report(const State& state, const Sample& s, const std::string& why) const;
     void addWork(const State& state, const Sample& s);
 
+    double safety_ = 0.8;  ///< time.safety, for the advice on adaptive steps
     double speedLimit_ = kLightSpeed;
     Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
     bool hasGravity_ = false;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "sim/Fracture.h"
 #include "sim/Material.h"
@@ -38,6 +39,11 @@ Membrane::Membrane(const MembraneParams& params)
         theta_ = diffusion_->initialTheta();
     }
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
+    controller_ = TimeStepController(params.time);
+    const MaterialParams& m = params.material;
+    if (m.fractureEnergy)
+        criticalStretch_ = std::sqrt(2.0 * std::numbers::pi * *m.fractureEnergy /
+                                     (3.0 * m.youngsModulus * horizon_));
     updateDamage();
 }
 
@@ -136,7 +142,8 @@ void Membrane::kick(double h, double tNext) {
 }
 
 void Membrane::checkFinite() {
-    guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_},
+    guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
+                  adaptiveStep_},
                  [this] { return kineticEnergy() + strainEnergy(); });
 }
 
@@ -228,7 +235,62 @@ void Membrane::step() {
     }
     time_ += dt_;
     ++steps_;
+    dtMin_ = std::min(dtMin_, dt_);
+    dtMax_ = std::max(dtMax_, dt_);
     checkFinite();
+}
+
+// Broken bonds, and the triangles element erosion removed (its bonds may stay intact).
+std::size_t Membrane::breakCount() const {
+    return damageState_.brokenBondCount() + damageState_.removedTriangleCount();
+}
+
+double Membrane::currentStableTimeStep() const { return stableDt_ / std::sqrt(stiffening_); }
+
+// Only loaded bonds count: what a step must resolve is the order in which bonds near a crack
+// tip reach eta_c, not the lattice-scale ringing of unloaded ones (which the bound keeps stable).
+double Membrane::criticalStretchRate() const {
+    if (!std::isfinite(criticalStretch_)) return 0.0;
+    const int n = particleCount();
+    const std::vector<std::uint8_t>& alive = damageState_.bondAlive();
+    const MaterialParams& m = params_.material;
+    const bool heated = !theta_.empty();
+    double fastest = 0.0;  // a maximum: the same for any thread count
+#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            if (j < i || !alive[b]) continue;  // each bond once
+            const Eigen::Vector3d xi = x_[j] - x_[i];
+            const double rest = bonds_.restLength[b];
+            const double thetaBar = heated ? 0.5 * (theta_[i] + theta_[j]) : 0.0;
+            const double critical = criticalStretch_ * degradation(m.strengthLoss, thetaBar);
+            // Loaded: |xi| / L0 - 1 - alpha theta > eta_c / 2, compared squared (no root).
+            const double loaded = rest * (1.0 + m.expansion * thetaBar + 0.5 * critical);
+            if (!(critical > 0.0 && xi.squaredNorm() > loaded * loaded)) continue;
+            // ds/dt = (xi . dv) / (|xi| L0)
+            const double rate = std::abs(xi.dot(v_[j] - v_[i])) / (xi.norm() * rest);
+            fastest = std::max(fastest, rate / critical);
+        }
+    }
+    return fastest;
+}
+
+// The last step of a frame is not clipped to a sliver: the time left is split evenly into as
+// few steps as the controller allows.
+void Membrane::advanceTo(double tEnd) {
+    while (time_ < tEnd) {
+        const double wanted = controller_.next(currentStableTimeStep());
+        const double left = tEnd - time_;
+        const double pieces = std::ceil(left / wanted * (1.0 - 1e-12));
+        dt_ = pieces <= 1.0 ? left : left / pieces;
+        const std::size_t before = breakCount();
+        adaptiveStep_ = true;
+        step();
+        adaptiveStep_ = false;
+        if (pieces <= 1.0) time_ = tEnd;  // exactly, whatever the rounding of time_ + dt_
+        controller_.record(dt_, breakCount() - before, criticalStretchRate());
+    }
 }
 
 void Membrane::updateDamage() {

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -26,6 +27,7 @@
 #include "sim/Params.h"
 #include "sim/Random.h"
 #include "sim/Solver.h"
+#include "sim/TimeStep.h"
 
 namespace rend::sim {
 
@@ -55,11 +57,28 @@ public:
     long stepCount() const { return steps_; }
     /// Extra pieces steps were cut into because the power law stiffened in compression.
     long extraSubsteps() const { return subSteps_; }
+    /// The smallest and largest step taken so far (0 before the first).
+    double smallestTimeStep() const { return steps_ > 0 ? dtMin_ : 0.0; }
+    double largestTimeStep() const { return dtMax_; }
+    /// The stable bound now: the rest one over the square root of the last stiffening.
+    double currentStableTimeStep() const;
+    /// The adaptive step's stretch measure, the same for every solver: over the intact bonds of
+    /// the bond families (every pair within R) loaded past half the critical stretch, the
+    /// largest |ds/dt| / eta_c [1/s], s = |x_j - x_i| / |x0_j - x0_i| - 1. 0 when nothing breaks.
+    double criticalStretchRate() const;
+    /// The eta_c that scales it: the continuum's calibrated sqrt(2 pi G_f / (3 E R)) (Fracture.h),
+    /// infinite without a fracture energy.
+    double referenceCriticalStretch() const { return criticalStretch_; }
+    const TimeStepController& stepController() const { return controller_; }
 
     /// One explicit step (eq. 26): bond forces (breaking bonds past eta_c, yielding
     /// elastoplastic ones), then velocities, then positions, then theta. Throws
     /// NumericalBlowUp naming the step and the first offending particle.
     void step();
+
+    /// Adaptive stepping (time.dt = "adaptive", sim/TimeStep.h): steps until time() is exactly
+    /// tEnd, each step from the controller, the last ones evened out to land on tEnd.
+    void advanceTo(double tEnd);
 
     /// The solver's internal forces on every particle (for the bonds, eq. 22 with the current
     /// bond direction), without changing any state.
@@ -136,6 +155,7 @@ private:
     void integrate(double h, double tNext);
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
+    std::size_t breakCount() const;
 
     MembraneParams params_;
     Lattice lattice_;
@@ -154,6 +174,10 @@ private:
     std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
     double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
+    TimeStepController controller_;
+    double criticalStretch_ = std::numeric_limits<double>::infinity();
+    bool adaptiveStep_ = false;  ///< step() runs inside advanceTo (the guard's advice)
+    double dtMin_ = std::numeric_limits<double>::infinity(), dtMax_ = 0.0;
     static constexpr int kMaxPieces = 64;
 
     // Structure of arrays: one contiguous array per attribute.

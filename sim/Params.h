@@ -145,13 +145,25 @@ struct BoundaryCondition {
 /// (half kick, drift, new forces, half kick), second order and better at conserving energy.
 enum class Integrator { SymplecticEuler, VelocityVerlet };
 
+/// Without a numeric dt: "auto" (a fixed step, safety x the stable bound at rest) or "adaptive"
+/// (sim/TimeStep.h: safety x the current bound, cut further where accuracy needs it).
+enum class StepControl { Auto, Adaptive };
+
 struct TimeParams {
     Integrator integrator = Integrator::SymplecticEuler;
-    std::optional<double> dt;  ///< nullopt: "auto", safety * the Silling-Askari bound
-    double safety = 0.8;       ///< Peridigm uses 0.8-0.85
-    double duration = 5.0;     ///< simulated seconds
+    std::optional<double> dt;  ///< a number: a fixed step; nullopt: `control` says which
+    StepControl control = StepControl::Adaptive;  ///< Auto or Adaptive when dt is nullopt
+    double safety = 0.8;                          ///< Peridigm uses 0.8-0.85
+    /// Adaptive: the most a loaded bond's stretch may change in one step, as a fraction of the
+    /// critical stretch (sim/TimeStep.h).
+    double maxStretchIncrement = 0.02;
+    /// Adaptive: a step that breaks more bonds than this shrinks the next ones (a burst).
+    int burstBonds = 8;
+    double duration = 5.0;  ///< simulated seconds
     double fps = 24.0;
     bool allowUnstable = false;  ///< expert: accept dt above the bound (the guard still runs)
+
+    bool adaptive() const { return !dt && control == StepControl::Adaptive; }
 };
 
 struct MembraneParams {

@@ -157,6 +157,13 @@ std::vector<Variation> variations() {
         {"forces.pressure", {"forces.pressure=10"}},
         {"time.dt", {"time.dt=1e-3"}},
         {"time.safety", {"time.safety=0.5"}},
+        // A weak sheet, so bonds near the notch are loaded towards breaking within two frames.
+        {"time.max_stretch_increment",
+         {"time.max_stretch_increment=0.001"},
+         {"material.fracture_energy=1e-3"}},
+        {"time.burst_bonds",
+         {"time.burst_bonds=1"},
+         {"material.fracture_energy=1e-3", "time.max_stretch_increment=1"}},
         {"time.duration", {"time.duration=0.125"}},
         {"time.fps", {"time.fps=30"}},
         {"time.allow_unstable", {"time.allow_unstable=true"}, {"time.dt=0.006"}},

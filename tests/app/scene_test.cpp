@@ -126,10 +126,13 @@ TEST_F(SceneTest, StretchSceneLoadsWithPresetAndEdgeBoundaries) {
     EXPECT_TRUE(right.region.contains({1.0, 1.0, 0}));
     EXPECT_FALSE(right.region.contains({0.97, 0, 0}));
 
-    ASSERT_TRUE(s.sim.time.dt.has_value());
-    EXPECT_DOUBLE_EQ(*s.sim.time.dt, 1e-4);
+    EXPECT_FALSE(s.sim.time.dt.has_value()) << "shipped scenes take the adaptive step";
+    EXPECT_TRUE(s.sim.time.adaptive());
     EXPECT_EQ(s.frameCount(), 120);
-    EXPECT_EQ(s.locationOf("time.dt"), kStretch.string() + ":" + valueLocation(kStretch, "dt = "));
+    const std::string table = valueLocation(kStretch, "[time]");
+    EXPECT_EQ(s.locationOf("time.dt"),
+              kStretch.string() + ":" + table.substr(0, table.find(':')) + ":1")
+        << "absent: its table";
 
     EXPECT_EQ(s.renderer, RendererKind::Osmesa);
     EXPECT_EQ(s.render.width, 960);
@@ -159,9 +162,10 @@ TEST_F(SceneTest, ResolvedJsonHasThePresetMergedIn) {
     EXPECT_NE(s.resolvedJson.find("\"boundary\" : ["), std::string::npos);
 }
 
-TEST_F(SceneTest, DefaultsFrameTheSheetAndUseAutoDt) {
+TEST_F(SceneTest, DefaultsFrameTheSheetAndUseTheAdaptiveDt) {
     const Scene s = loadScene(writeScene("minimal.toml", kMinimal));
     EXPECT_FALSE(s.sim.time.dt.has_value());
+    EXPECT_TRUE(s.sim.time.adaptive());
     EXPECT_EQ(s.locationOf("time.dt"), writeScene("minimal.toml", kMinimal).string() + ":1:1");
     EXPECT_EQ(s.frameCount(), 120) << "5 s at 24 fps";
     EXPECT_EQ(s.sim.material.name, "custom");
@@ -413,6 +417,8 @@ TEST_F(SceneTest, SetOverridesValues) {
 TEST_F(SceneTest, SetAutoDtClearsTheStepAndPointsAtTheOverride) {
     const Scene s = loadScene(kStretch, {"time.dt=auto"});
     EXPECT_FALSE(s.sim.time.dt.has_value());
+    EXPECT_EQ(s.sim.time.control, sim::StepControl::Auto);
+    EXPECT_TRUE(loadScene(kStretch, {"time.dt=adaptive"}).sim.time.adaptive());
     EXPECT_EQ(s.locationOf("time.dt"), "--set 'time.dt=auto'");
 }
 
@@ -448,7 +454,8 @@ TEST_F(SceneTest, SetValuesAreCheckedLikeFileValues) {
 TEST_F(SceneTest, SetOfAnUnknownKeyIsRejected) {
     EXPECT_EQ(errorOf(kStretch, {"time.dtt=1e-4"}),
               "--set 'time.dtt=1e-4': error: unknown key 'dtt' in [time]; expected one of: dt, "
-              "safety, duration, fps, allow_unstable, allow_slow, integrator. Did you mean 'dt'?");
+              "safety, max_stretch_increment, burst_bonds, duration, fps, allow_unstable, "
+              "allow_slow, integrator. Did you mean 'dt'?");
     EXPECT_NE(errorOf(kStretch, {"rendr.width=5"}).find("unknown key 'rendr'"), std::string::npos);
 }
 

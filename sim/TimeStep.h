@@ -1,0 +1,65 @@
+#pragma once
+// The accuracy-driven explicit step of time.dt = "adaptive". Table 1's fixed steps sit 60-120x
+// below the stable bound, yet the bound alone (dt = "auto") leaves the broken-bond count of a
+// running crack scattered: a step that moves a crack tip past several bonds at once decides
+// their order by the step, not by the physics. So each step takes
+//
+//     dt = min(safety x bound,                      stability (Silling & Askari 2005)
+//              max_stretch_increment / max |ds/dt|, no intact bond's stretch s jumps far
+//              burst cap)                           a step that broke many bonds shrinks the next
+//
+// and never grows by more than kGrowth over the step before, nor falls below 1/64 of safety x
+// bound. The bound is the rest one over the square root of the solver's stiffening (the power law
+// in compression), recomputed every step. The stretch rate is measured on the Membrane's bond
+// families (every particle pair within the cutoff R), which every solver has, so the same limit
+// serves the bonds, the elements, the springs and SPH alike; breaks are the DamageState's broken
+// bonds and removed triangles.
+//
+// Inputs are a maximum and counts, which no thread count changes: the steps, and so the run,
+// are bitwise identical for any number of threads.
+
+#include <cstddef>
+#include <limits>
+
+#include "sim/Params.h"
+
+namespace rend::sim {
+
+/// Which limit chose a step.
+enum class StepLimit { Bound, Stretch, Burst, Growth, Count };
+
+class TimeStepController {
+public:
+    static constexpr double kGrowth = 1.25;  ///< most a step grows over the one before
+    /// A burst cuts the next step by at most this factor, so one violent step cannot stall a run.
+    static constexpr double kMostShrink = 0.125;
+
+    TimeStepController() = default;
+    explicit TimeStepController(const TimeParams& time);
+
+    /// The step wanted next, given the stable bound now (rest bound / sqrt(stiffening)).
+    double next(double stableDt);
+    /// After a step of `taken` seconds (at most what next() wanted, less where a frame ended),
+    /// which broke `broken` bonds and left `stretchRate` = max |ds/dt| over intact bonds.
+    void record(double taken, std::size_t broken, double stretchRate);
+
+    StepLimit lastLimit() const { return lastLimit_; }
+    /// Steps each limit chose, indexed by StepLimit.
+    const long* limitCounts() const { return counts_; }
+    /// The most bonds one step broke.
+    std::size_t largestBurst() const { return largestBurst_; }
+
+private:
+    double safety_ = 0.8;
+    double maxIncrement_ = 1e-3;
+    double burstBonds_ = 8;
+    double stretchRate_ = 0.0;
+    double wanted_ = 0.0;                                   ///< what next() last returned
+    double cap_ = std::numeric_limits<double>::infinity();  ///< growth and burst limits
+    bool burst_ = false;  ///< cap_ comes from a burst, not from growth
+    StepLimit lastLimit_ = StepLimit::Bound;
+    long counts_[int(StepLimit::Count)] = {};
+    std::size_t largestBurst_ = 0;
+};
+
+}  // namespace rend::sim

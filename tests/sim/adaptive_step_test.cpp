@@ -1,0 +1,178 @@
+// The adaptive time step (sim/TimeStep.h): its controller alone, and driven by a Membrane.
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <tuple>
+
+#include "sim/Membrane.h"
+#include "sim/TimeStep.h"
+
+namespace rend::sim {
+namespace {
+
+/// A 1 m notched sheet (2.9K particles, over the parallel threshold) pulled apart at its top and
+/// bottom edges: the crack runs from the notch within half a second.
+MembraneParams tearingSheet() {
+    MembraneParams p;
+    p.sheet.size = {1.0, 1.0};
+    p.sheet.dx = 0.02;
+    p.material.youngsModulus = 2e4;
+    p.material.density = 5000;
+    p.material.fractureEnergy = 1.0;
+    p.notches = {Notch{{{-0.55, 0.001}, {-0.2, 0.001}}}};
+    BoundaryCondition top, bottom;
+    top.kind = bottom.kind = BoundaryKind::Velocity;
+    top.region.min.y() = 0.48;
+    bottom.region.max.y() = -0.48;
+    top.velocity = {0, 0.3, 0};
+    bottom.velocity = {0, -0.3, 0.01};
+    p.boundaries = {top, bottom};
+    return p;
+}
+
+TEST(TimeStepController, TakesTheSafetyTimesTheBoundWhenNothingLimitsIt) {
+    TimeParams t;
+    TimeStepController c(t);
+    EXPECT_DOUBLE_EQ(c.next(1.0), 0.8);
+    EXPECT_EQ(c.lastLimit(), StepLimit::Bound);
+    c.record(0.8, 0, 0.0);
+    EXPECT_DOUBLE_EQ(c.next(0.5), 0.4) << "follows the bound down at once (stiffening)";
+}
+
+TEST(TimeStepController, CutsTheStepSoNoLoadedBondStretchesMoreThanTheAllowedIncrement) {
+    TimeParams t;
+    t.maxStretchIncrement = 0.05;
+    TimeStepController c(t);
+    c.next(1.0);
+    c.record(0.8, 0, 2.0);  // loaded bonds approach eta_c at 2 eta_c per second
+    EXPECT_DOUBLE_EQ(c.next(1.0), 0.025);
+    EXPECT_EQ(c.lastLimit(), StepLimit::Stretch);
+}
+
+TEST(TimeStepController, ABurstOfBreakingShrinksTheNextStepsWhichRegrowByAtMostAQuarter) {
+    TimeParams t;
+    t.burstBonds = 8;
+    TimeStepController c(t);
+    c.next(1.0);
+    c.record(0.8, 8, 0.0);
+    EXPECT_DOUBLE_EQ(c.next(1.0), 0.8) << "eight bonds in one step are no burst";
+    c.record(0.8, 32, 0.0);
+    double dt = c.next(1.0);
+    EXPECT_DOUBLE_EQ(dt, 0.2) << "four times the allowed breaks: a quarter of the step";
+    EXPECT_EQ(c.lastLimit(), StepLimit::Burst);
+    c.record(dt, 1000, 0.0);
+    dt = c.next(1.0);
+    EXPECT_DOUBLE_EQ(dt, 0.2 * TimeStepController::kMostShrink) << "one step cuts at most 8x";
+    int steps = 0;
+    for (double last = dt; dt < 0.8; last = dt, ++steps) {
+        c.record(dt, 0, 0.0);
+        dt = c.next(1.0);
+        EXPECT_LE(dt, TimeStepController::kGrowth * last * (1 + 1e-15));
+        EXPECT_GT(dt, last);
+    }
+    EXPECT_EQ(steps, 16) << "0.025 regrows to 0.8 by 1.25x a step: 1.25^16 > 32";
+    EXPECT_EQ(c.largestBurst(), 1000u);
+}
+
+TEST(AdaptiveStep, LandsExactlyOnFrameTimes) {
+    Membrane m(tearingSheet());
+    for (int frame = 1; frame <= 6; ++frame) {
+        m.advanceTo(frame / 24.0);
+        EXPECT_EQ(m.time(), frame / 24.0) << "frame " << frame;
+    }
+    EXPECT_GT(m.stepCount(), 6) << "several steps per frame";
+}
+
+TEST(AdaptiveStep, NeverExceedsTheSafetyTimesTheStableBound) {
+    MembraneParams p = tearingSheet();
+    p.time.safety = 0.6;
+    Membrane m(p);
+    m.advanceTo(0.5);
+    EXPECT_GT(m.brokenBondCount(), m.notchedBondCount()) << "the crack ran";
+    EXPECT_LE(m.largestTimeStep(), 0.6 * m.stableTimeStep() * (1 + 1e-12));
+    EXPECT_GE(m.largestTimeStep(), 0.59 * m.stableTimeStep()) << "and reaches it";
+}
+
+TEST(AdaptiveStep, ShrinksDuringABurstOfBreakingAndRegrows) {
+    MembraneParams p = tearingSheet();
+    p.time.burstBonds = 2;
+    p.time.maxStretchIncrement = 1.0;  // the stretch limit alone keeps most bursts away
+    Membrane m(p);
+    const double full = 0.8 * m.stableTimeStep();
+    for (int frame = 1; frame <= 48; ++frame) m.advanceTo(frame / 24.0);
+    const long* limits = m.stepController().limitCounts();
+    EXPECT_GT(m.stepController().largestBurst(), 2u);
+    EXPECT_GT(limits[int(StepLimit::Burst)], 0) << "bursts of more than 2 bonds cut the step";
+    EXPECT_LT(m.smallestTimeStep(), 0.2 * full);
+    // From 1/8 of the bound back to it: 9 steps limited by growth (1.25^9 = 7.5), then the bound.
+    EXPECT_GE(limits[int(StepLimit::Growth)], 9) << "regrowing gradually";
+    EXPECT_EQ(m.stepController().lastLimit(), StepLimit::Bound) << "back at the bound";
+}
+
+TEST(AdaptiveStep, OneAndTwoThreadsGiveIdenticalBits) {
+    auto run = [](int threads) {
+        omp_set_num_threads(threads);
+        Membrane m(tearingSheet());
+        EXPECT_GT(m.particleCount(), kParallelThreshold) << "must take the parallel path";
+        for (int frame = 1; frame <= 12; ++frame) m.advanceTo(frame / 24.0);
+        return std::tuple(m.positions(), m.damageState().bondAlive(), m.stepCount());
+    };
+    const auto [x1, alive1, steps1] = run(1);
+    const auto [x2, alive2, steps2] = run(2);
+    omp_set_num_threads(2);
+    EXPECT_EQ(steps1, steps2);
+    ASSERT_EQ(x1.size(), x2.size());
+    EXPECT_EQ(std::memcmp(x1.data(), x2.data(), x1.size() * sizeof(x1[0])), 0);
+    EXPECT_EQ(alive1, alive2);
+    EXPECT_GT(std::count(alive1.begin(), alive1.end(), 0), 0) << "it tore";
+}
+
+TEST(AdaptiveStep, ABlowUpAdvisesALowerSafetyOrAFixedStep) {
+    MembraneParams p = tearingSheet();
+    p.time.safety = 0.7;
+    Membrane m(p);
+    m.advanceTo(0.1);
+    const int free = m.nearestParticle({0.2, 0.2});  // away from the grips
+    m.velocities()[free].x() = std::numeric_limits<double>::quiet_NaN();
+    try {
+        m.advanceTo(0.2);
+        FAIL() << "the guard let a NaN through";
+    } catch (const NumericalBlowUp& e) {
+        EXPECT_EQ(e.particle, free);
+        const std::string message = e.what();
+        EXPECT_NE(message.find("lower time.safety (now 0.7) or use a fixed dt <= "),
+                  std::string::npos)
+            << message;
+    }
+    Membrane fixed(p);  // step() alone is a fixed step: the usual advice
+    fixed.velocities()[free].x() = std::numeric_limits<double>::quiet_NaN();
+    try {
+        fixed.step();
+        FAIL() << "the guard let a NaN through";
+    } catch (const NumericalBlowUp& e) {
+        EXPECT_EQ(std::string(e.what()).find("time.safety"), std::string::npos) << e.what();
+    }
+}
+
+TEST(AdaptiveStep, MeasuresStretchOnlyOnBondsLoadedTowardsBreaking) {
+    MembraneParams p = tearingSheet();
+    Membrane atRest(p);
+    atRest.velocities()[0] = {1, 0, 0};  // fast, but its bonds are not loaded
+    EXPECT_EQ(atRest.criticalStretchRate(), 0.0);
+    for (auto& x : atRest.positions()) x.y() *= 1.0 + atRest.referenceCriticalStretch();
+    EXPECT_GT(atRest.criticalStretchRate(), 1.0 / atRest.referenceCriticalStretch())
+        << "stretched past eta_c / 2, the fast particle's bonds count";
+    p.material.fractureEnergy.reset();
+    Membrane unbreakable(p);
+    EXPECT_EQ(unbreakable.criticalStretchRate(), 0.0) << "nothing breaks: no stretch limit";
+    EXPECT_FALSE(std::isfinite(unbreakable.referenceCriticalStretch()));
+}
+
+}  // namespace
+}  // namespace rend::sim

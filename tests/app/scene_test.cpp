@@ -194,7 +194,7 @@ box = { min = [0.9, 1.9], max = [1.1, 2.1] }
 [[boundary]]
 type = "velocity"
 edge = "top"
-depth = 2
+depth = 0.1
 velocity = [0, 0, 1]
 
 [time]
@@ -748,7 +748,7 @@ rate = 1.0
 
 [[diffusion.edge]]
 edge = "left"
-depth = 2
+depth = 0.1
 value = 1.0
 
 [[diffusion.edge]]
@@ -791,7 +791,8 @@ value = -0.5
 
     ASSERT_EQ(d.edges.size(), 2u);
     EXPECT_DOUBLE_EQ(d.edges[0].value, 1.0);
-    EXPECT_NEAR(d.edges[0].region.max.x(), -0.5 + 0.1, 1e-9) << "depth 2 * dx, like [[boundary]]";
+    EXPECT_NEAR(d.edges[0].region.max.x(), -0.5 + 0.1, 1e-9)
+        << "depth in metres, like [[boundary]]";
     EXPECT_TRUE(std::isinf(d.edges[0].region.min.x()));
     EXPECT_EQ(d.edges[1].region.min, Eigen::Vector2d(0.4, -0.25));
     EXPECT_EQ(d.edges[1].region.max, Eigen::Vector2d(0.5, 0.25));

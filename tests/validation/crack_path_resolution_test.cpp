@@ -23,6 +23,11 @@ using namespace rend;
 
 namespace {
 
+/// A fifth of the stable step: at 0.8 of it the preview crack kinks off its line and branches
+/// within 0.3 m while the dx / 2 one runs straight; at 0.2, like at Table 1's fixed 1e-4 s, both
+/// run straight and branch at the same place (see the report in README "Resolution").
+constexpr double kSafety = 0.2;
+
 struct CrackPath {
     std::vector<Eigen::Vector2d> midpoints;  ///< of the bonds broken while running
     double dx = 0;
@@ -33,9 +38,9 @@ struct CrackPath {
 /// each of `times` (seconds, ascending).
 std::vector<CrackPath> tear(const std::string& scene, const std::vector<double>& times,
                             std::vector<std::string> sets) {
-    const char* dt = std::getenv("REND_CRACK_DT");
-    sets.insert(sets.end(), {std::string("time.dt=") + (dt ? dt : "auto"), "time.duration=" + std::to_string(times.back()),
-                             "render.renderer=none"});
+    sets.insert(sets.end(),
+                {"time.dt=auto", "time.safety=" + std::to_string(kSafety),
+                 "time.duration=" + std::to_string(times.back()), "render.renderer=none"});
     const Scene s = loadScene(std::string(REND_SOURCE_DIR) + "/scenes/" + scene, sets);
     sim::Membrane m = prepareMembrane(s);
     const std::vector<std::uint8_t> notched = m.damageState().bondAlive();
@@ -113,15 +118,9 @@ void expectSamePath(const std::string& scene, const std::vector<double>& times,
 }  // namespace
 
 TEST(CrackPathResolution, CrackPathSourcesTearsAlongTheSamePathAtHalfTheSpacing) {
-    expectSamePath("crack_path_sources.toml", {1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0}, {-0.3, 0.0},
-                   0.5);
+    expectSamePath("crack_path_sources.toml", {1.5, 1.75}, {-0.3, 0.0}, 0.4);
 }
 
 TEST(CrackPathResolution, FoilTearTearsAlongTheSamePathAtHalfTheSpacing) {
-    expectSamePath("foil_tear.toml", {2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0}, {0.01, 0.8},
-                   0.5);
-}
-
-TEST(CrackPathResolution, TmpCrackPath) {
-    expectSamePath("crack_path.toml", {1.5, 1.75, 2.0, 2.25, 2.5, 3.0}, {-0.3, 0.0}, 0.5);
+    expectSamePath("foil_tear.toml", {5.0, 6.0, 7.0}, {0.01, 0.8}, 0.2);
 }

@@ -270,8 +270,8 @@ INSTANTIATE_TEST_SUITE_P(
                   "-20000. Use e.g. E = 2e4."}},
         BadScene{"bad_missing_dx.toml",
                  "2:1",
-                 {"sheet.dx is missing: expected the particle spacing in metres (in [1e-06, "
-                  "1000]). Add e.g. dx = 0.02 under [sheet]."}},
+                 {"sheet.dx is missing: expected the particle spacing in metres at quality = "
+                  "\"preview\" (in [1e-06, 1000]). Add e.g. dx = 0.02 under [sheet]."}},
         BadScene{"bad_missing_sheet.toml", "1:1", {"sheet.dx is missing"}},
         BadScene{"bad_enum.toml",
                  "5:11",

@@ -14,6 +14,12 @@ namespace rend {
 
 enum class RendererKind { Osmesa, None, Embree };
 
+/// The resolution a scene runs at: preview at [sheet] dx, final at dx_final (names::kQualities).
+enum class Quality { Preview, Final };
+
+/// Particles per sheet that quality = "final" asks for at least.
+inline constexpr std::size_t kFinalParticles = 250000;
+
 /// Per-frame files besides the PNG: meshes through assimp, level sets through OpenVDB.
 enum class ExportFormat { Ply, Obj, Glb, Vdb };
 
@@ -24,6 +30,11 @@ struct Scene {
     RendererKind renderer = RendererKind::Osmesa;
     bool writeStats = true;
     std::vector<ExportFormat> exports;  ///< [output] export, in the order given
+
+    Quality quality = Quality::Preview;
+    /// [sheet] dx, the preview spacing [m]: the default width of edge strips, and the spacing
+    /// seeded draws refer to, so both stay put in metres at every quality.
+    double previewDx = 0.0;
 
     /// Whether a run estimated beyond the cost limit may start ([time] allow_slow).
     bool allowSlow = false;

@@ -15,6 +15,7 @@
 #include "app/SceneNames.h"
 #include "app/SceneReader.h"
 #include "render/Look.h"
+#include "sim/Lattice.h"
 #include "sim/SolverRegistry.h"
 
 namespace rend {
@@ -96,24 +97,25 @@ void readOutline(const TableReader& t, sim::SheetParams& s) {
 }
 
 /// dx is bounded by the outline on both sides: coarse enough for the memory budget, fine enough
-/// to resolve the sheet at all.
-void checkSpacing(const TableReader& t, const sim::SheetParams& s) {
+/// to resolve the sheet at all. `key` is the key that chose it (dx or dx_final).
+void checkSpacing(const TableReader& t, const sim::SheetParams& s, std::string_view key) {
     const SheetExtent e = extentOf(s);
     const double maxDx = e.smallest / (kMinParticlesAcross - 1);
     if (s.dx > maxDx) {
-        t.fail("dx",
+        t.fail(key,
                "a spacing of at most " + formatNumber(roundForDisplay(maxDx, -1)) +
                    " m, so that at least 4 particles fit "
                    "across the sheet's smaller extent of " +
                    formatNumber(e.smallest) + " m",
                formatNumber(s.dx),
-               "Use e.g. dx = " + formatNumber(roundForDisplay(e.smallest / 50)) + ".");
+               "Use e.g. " + std::string(key) + " = " +
+                   formatNumber(roundForDisplay(e.smallest / 50)) + ".");
     }
     const SheetEstimate estimate = estimateSheet(s);
     if (estimate.bytes > kMaxMemoryBytes) {
         // Memory grows as 1/dx^2 at a fixed horizon, so this dx fits the budget.
         const double minDx = s.dx * std::sqrt(estimate.bytes / kMaxMemoryBytes);
-        t.fail("dx",
+        t.fail(key,
                "a spacing that fits the memory limit of " + gigabytes(kMaxMemoryBytes) +
                    " (particles x (" + formatNumber(SheetEstimate::kBytesPerParticle) +
                    " bytes + bonds x " + formatNumber(SheetEstimate::kBytesPerBondEnd) +
@@ -122,14 +124,31 @@ void checkSpacing(const TableReader& t, const sim::SheetParams& s) {
                formatNumber(s.dx) + ": about " + formatNumber(roundForDisplay(estimate.particles)) +
                    " particles with " + formatNumber(std::round(estimate.bondsPerParticle)) +
                    " bonds each, about " + gigabytes(estimate.bytes),
-               "Use e.g. dx = " + formatNumber(roundForDisplay(minDx * 2, +1)) +
-                   ", or a smaller horizon.");
+               "Use e.g. " + std::string(key) + " = " +
+                   formatNumber(roundForDisplay(minDx * 2, +1)) + ", or a smaller horizon.");
     }
 }
 
-sim::SheetParams readSheet(const TableReader& root) {
+/// dx is the preview spacing; quality = "final" swaps in dx_final, else the coarsest spacing
+/// that gives the sheet kFinalParticles. Seeded draws stay on the preview lattice.
+void readQuality(const TableReader& t, Scene& scene) {
+    sim::SheetParams& s = scene.sim.sheet;
+    scene.quality = Quality(t.choice("quality").value_or(std::size_t(scene.quality)));
+    const std::optional<double> dxFinal = t.number("dx_final");
+    scene.previewDx = s.dx;
+    s.seedSpacing = s.dx;
+    if (scene.quality == Quality::Final)
+        s.dx = dxFinal.value_or(sim::spacingForParticles(s, kFinalParticles));
+    const bool chosen = scene.quality == Quality::Final && dxFinal;
+    checkSpacing(t, s,
+                 scene.quality == Quality::Final && !chosen ? "quality"
+                 : chosen                                   ? "dx_final"
+                                                            : "dx");
+}
+
+void readSheet(const TableReader& root, Scene& scene) {
     const TableReader t = root.section("sheet");
-    sim::SheetParams s;
+    sim::SheetParams& s = scene.sim.sheet;
     s.dx = t.requiredNumber("dx");
     readOutline(t, s);
     s.center = t.vec3("center").value_or(s.center);
@@ -138,8 +157,7 @@ sim::SheetParams readSheet(const TableReader& root) {
     s.thickness = t.number("thickness").value_or(s.thickness);
     s.perturbationAmplitude = t.number("perturbation").value_or(s.perturbationAmplitude);
     s.perturbationSeed = std::uint64_t(t.integer("seed").value_or(s.perturbationSeed));
-    checkSpacing(t, s);
-    return s;
+    readQuality(t, scene);
 }
 
 // ---- [material] ------------------------------------------------------------------------------
@@ -215,12 +233,12 @@ sim::MaterialParams readMaterial(const TableReader& root) {
 
 // ---- [[boundary]] ----------------------------------------------------------------------------
 
-/// The strip of width depth*dx along one side of the sheet's rest bounding box. The outer
+/// The strip `depth` metres wide along one side of the sheet's rest bounding box. The outer
 /// side stays unbounded and the inner one gets a hair of tolerance, so the particles exactly on
 /// the strip's edges are included despite rounding in the lattice.
 sim::Region edgeRegion(Edge edge, double depth, const sim::SheetParams& sheet) {
     const SheetExtent e = extentOf(sheet);
-    const double width = depth * sheet.dx + 1e-9 * sheet.dx;
+    const double width = depth + 1e-9 * sheet.dx;
     sim::Region r;
     switch (edge) {
         case Edge::Left:
@@ -255,7 +273,10 @@ sim::Region boxRegion(const TableReader& t) {
     return r;
 }
 
-sim::Region readRegion(const TableReader& t, const sim::SheetParams& sheet) {
+/// `depth` defaults to the preview spacing, one row of the preview lattice, in metres at every
+/// quality.
+sim::Region readRegion(const TableReader& t, const Scene& scene) {
+    const sim::SheetParams& sheet = scene.sim.sheet;
     if (t.has("edge") && t.has("box")) {
         t.fail("box", "either edge or box, not both", "both", "Remove edge or box.");
     }
@@ -268,7 +289,7 @@ sim::Region readRegion(const TableReader& t, const sim::SheetParams& sheet) {
     }
     if (!t.has("edge")) t.missing("edge", "or box = { min = [x, y], max = [x, y] }");
     const Edge edge = Edge(*t.choice("edge"));
-    return edgeRegion(edge, t.number("depth").value_or(1.0), sheet);
+    return edgeRegion(edge, t.number("depth").value_or(scene.previewDx), sheet);
 }
 
 /// Keys that only a velocity condition uses are errors on a pinned one, not silently ignored.
@@ -279,11 +300,11 @@ void rejectForPinned(const TableReader& t, std::string_view key) {
     }
 }
 
-sim::BoundaryCondition readBoundary(const TableReader& t, const sim::SheetParams& sheet) {
+sim::BoundaryCondition readBoundary(const TableReader& t, const Scene& scene) {
     sim::BoundaryCondition bc;
     if (!t.has("type")) t.missing("type", "one of \"velocity\", \"pinned\"");
     bc.kind = sim::BoundaryKind(*t.choice("type"));
-    bc.region = readRegion(t, sheet);
+    bc.region = readRegion(t, scene);
     if (bc.kind == sim::BoundaryKind::Pinned) {
         rejectForPinned(t, "velocity");
         rejectForPinned(t, "ramp");
@@ -295,11 +316,10 @@ sim::BoundaryCondition readBoundary(const TableReader& t, const sim::SheetParams
     return bc;
 }
 
-std::vector<sim::BoundaryCondition> readBoundaries(const TableReader& root,
-                                                   const sim::SheetParams& sheet) {
+std::vector<sim::BoundaryCondition> readBoundaries(const TableReader& root, const Scene& scene) {
     std::vector<sim::BoundaryCondition> conditions;
     for (const TableReader& t : root.entries("boundary"))
-        conditions.push_back(readBoundary(t, sheet));
+        conditions.push_back(readBoundary(t, scene));
     return conditions;
 }
 
@@ -393,14 +413,15 @@ sim::SpotScatter readScatter(const TableReader& t) {
     return s;
 }
 
-sim::DiffusionEdge readDiffusionEdge(const TableReader& t, const sim::SheetParams& sheet) {
+sim::DiffusionEdge readDiffusionEdge(const TableReader& t, const Scene& scene) {
     sim::DiffusionEdge e;
-    e.region = readRegion(t, sheet);
+    e.region = readRegion(t, scene);
     e.value = t.requiredNumber("value");
     return e;
 }
 
-sim::DiffusionParams readDiffusion(const TableReader& root, const sim::SheetParams& sheet) {
+sim::DiffusionParams readDiffusion(const TableReader& root, const Scene& scene) {
+    const sim::SheetParams& sheet = scene.sim.sheet;
     const TableReader t = root.section("diffusion");
     sim::DiffusionParams d;
     d.initial = t.number("initial").value_or(d.initial);
@@ -415,7 +436,7 @@ sim::DiffusionParams readDiffusion(const TableReader& root, const sim::SheetPara
         }
     }
     for (const TableReader& edge : t.entries("edge"))
-        d.edges.push_back(readDiffusionEdge(edge, sheet));
+        d.edges.push_back(readDiffusionEdge(edge, scene));
     return d;
 }
 
@@ -672,11 +693,11 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
                            file.string());
     Scene s;
     s.file = file;
-    s.sim.sheet = readSheet(root);
+    readSheet(root, s);
     s.sim.material = readMaterial(root);
-    s.sim.boundaries = readBoundaries(root, s.sim.sheet);
+    s.sim.boundaries = readBoundaries(root, s);
     s.sim.notches = readNotches(root, s.sim.sheet);
-    s.sim.diffusion = readDiffusion(root, s.sim.sheet);
+    s.sim.diffusion = readDiffusion(root, s);
     readForces(root, s.sim);
     readSolver(root, s.sim);
     readTime(root, s);

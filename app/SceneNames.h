@@ -11,6 +11,7 @@ namespace rend::names {
 
 inline constexpr std::string_view kShapes[] = {"rectangle", "disc", "sphere"};  // sim::Outline
 inline constexpr std::string_view kLattices[] = {"hexagonal", "square"};
+inline constexpr std::string_view kQualities[] = {"preview", "final"};  // rend::Quality
 inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
 inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper"};

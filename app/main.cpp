@@ -33,19 +33,27 @@ void printVersions() {
         std::printf("  %-10s %s\n", name.c_str(), version.c_str());
 }
 
-int checkCommand(const std::string& file, const std::vector<std::string>& sets) {
-    const rend::Scene scene = rend::loadScene(file, sets);
+/// --quality is [sheet] quality given last, so it wins over the file and every --set.
+std::vector<std::string> withQuality(std::vector<std::string> sets, const std::string& quality) {
+    if (!quality.empty()) sets.push_back("sheet.quality=" + quality);
+    return sets;
+}
+
+int checkCommand(const std::string& file, const std::vector<std::string>& sets,
+                 const std::string& quality) {
+    const rend::Scene scene = rend::loadScene(file, withQuality(sets, quality));
     const rend::sim::Membrane membrane = rend::prepareMembrane(scene);
     const auto [substeps, dt] = rend::substepsPerFrame(membrane.timeStep(), scene.sim.time.fps);
     const rend::RunEstimate estimate = rend::estimateRun(scene, membrane);
     const rend::SheetEstimate sheet = rend::estimateSheet(scene.sim.sheet);
     const bool adaptive = scene.sim.time.adaptive();  // steps of at most dt, more where needed
     std::printf(
-        "%s: ok\n  %d particles, %zu bonds, dt %s%.4g s (stable limit %.4g s), "
-        "%s%d steps per frame, %d frames\n"
+        "%s: ok (quality %s, dx %.4g m)\n  %d particles, %zu bonds, dt %s%.4g s (stable limit "
+        "%.4g s), %s%d steps per frame, %d frames\n"
         "  estimated memory %.3g GB (%.3g particles x (%g B + %.3g bonds x %g B))\n"
         "  estimated cost: %s\n",
-        file.c_str(), membrane.particleCount(), membrane.bondCount(),
+        file.c_str(), std::string(rend::names::kQualities[std::size_t(scene.quality)]).c_str(),
+        scene.sim.sheet.dx, membrane.particleCount(), membrane.bondCount(),
         adaptive ? "adaptive, at most " : "", dt, membrane.stableTimeStep(),
         adaptive ? "at least " : "", substeps, scene.frameCount(), sheet.bytes / 1e9,
         sheet.particles, rend::SheetEstimate::kBytesPerParticle, sheet.bondsPerParticle,
@@ -66,7 +74,7 @@ std::vector<std::string> members(std::span<const std::string_view> names) {
 }
 
 struct RunArgs {
-    std::string scene, out = "out", frames, renderer, surface, exports;
+    std::string scene, out = "out", frames, renderer, surface, exports, quality;
     std::vector<std::string> sets;
     int threads = 0;
     int spp = 0;
@@ -103,7 +111,7 @@ void applyOverrides(const RunArgs& a, rend::Scene& scene) {
 
 int runCommand(const RunArgs& a) {
     if (a.threads > 0) omp_set_num_threads(a.threads);
-    rend::Scene scene = rend::loadScene(a.scene, a.sets);
+    rend::Scene scene = rend::loadScene(a.scene, withQuality(a.sets, a.quality));
     applyOverrides(a, scene);
     rend::RunOptions options;
     options.outDir = a.out;
@@ -120,6 +128,17 @@ int runCommand(const RunArgs& a) {
         a.out.c_str(), s.framesSimulated, s.framesWritten, s.particles, s.bonds, s.steps, s.dt,
         s.nsPerParticleStep);
     return 0;
+}
+
+/// --quality takes preview or final; anything else is bad input (exit 2) that names both.
+CLI::Validator qualityValidator() {
+    return CLI::Validator(
+        [](std::string& value) {
+            if (rend::names::indexOf(rend::names::kQualities, value)) return std::string();
+            return "expected " + namesText(rend::names::kQualities) + ", found \"" + value +
+                   "\". Use e.g. --quality final.";
+        },
+        "preview|final");
 }
 
 /// CLI11 stores `--frames ''` as an empty string, which reads like an absent option; an empty
@@ -155,6 +174,10 @@ int main(int argc, char** argv) {
     RunArgs run;
     CLI::App* runCmd = app.add_subcommand("run", "Simulate a scene and write its outputs");
     const CLI::Validator sceneFile = nonEmpty("a scene file", "scenes/stretch.toml");
+    const CLI::Validator quality = qualityValidator();
+    const std::string qualityHelp =
+        "Override [sheet] quality: preview (at dx) or final (dx_final, else >= 250,000 "
+        "particles)";
     runCmd->add_option("scene", run.scene, "Scene file (TOML)")->required()->check(sceneFile);
     runCmd->add_option("--out", run.out, "Output folder")
         ->capture_default_str()
@@ -171,13 +194,15 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 4096));
     runCmd->add_option("--threads", run.threads, "OpenMP threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
+    runCmd->add_option("--quality", run.quality, qualityHelp)->check(quality);
     runCmd->add_option("--set", run.sets, "Override a scene value: key.path=value (repeatable)");
     runCmd->footer(solverHelp());
 
-    std::string checkScene;
+    std::string checkScene, checkQuality;
     std::vector<std::string> checkSets;
     CLI::App* checkCmd = app.add_subcommand("check", "Parse and validate a scene, write nothing");
     checkCmd->add_option("scene", checkScene, "Scene file (TOML)")->required()->check(sceneFile);
+    checkCmd->add_option("--quality", checkQuality, qualityHelp)->check(quality);
     checkCmd->add_option("--set", checkSets, "Override a scene value: key.path=value");
 
     try {
@@ -191,7 +216,7 @@ int main(int argc, char** argv) {
     try {
         if (version) return printVersions(), 0;
         if (*runCmd) return runCommand(run);
-        if (*checkCmd) return checkCommand(checkScene, checkSets);
+        if (*checkCmd) return checkCommand(checkScene, checkSets, checkQuality);
         std::cout << app.help();
         return 2;
     } catch (const rend::SceneError& e) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "sim/Parallel.h"
 #include "sim/Random.h"
@@ -35,33 +36,64 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
         worst = std::max(worst, total);
     }
     stableDt_ = worst > 0.0 ? 1.0 / worst : std::numeric_limits<double>::infinity();
-    for (const DiffusionSpot& spot : params.diffusion.spots) addSpot(spot, rest);
-    for (const SpotScatter& scatter : params.diffusion.scatters) expandScatter(scatter, rest);
+    const SheetParams& sheet = params.sheet;
+    const bool seeded = sheet.seedSpacing > 0.0 && sheet.seedSpacing != sheet.dx;
+    const std::optional<Lattice> seeds =
+        seeded ? std::optional<Lattice>(seedLattice(sheet)) : std::nullopt;
+    SourceFrame frame{rest, {}, seeds ? &*seeds : nullptr};
+    for (const double v : volumes) frame.areas.push_back(v / sheet.thickness);
+    for (const DiffusionSpot& spot : params.diffusion.spots) addSpot(spot, frame);
+    for (const SpotScatter& scatter : params.diffusion.scatters) expandScatter(scatter, frame);
     for (const DiffusionEdge& edge : params.diffusion.edges)
         for (int i = 0; i < n; ++i)
             if (edge.region.contains(rest[i])) held_.emplace_back(i, edge.value);
 }
 
-void Diffusion::addSpot(const DiffusionSpot& spot, std::span<const Eigen::Vector3d> rest) {
-    Spot s{spot.start, spot.start + spot.duration, spot.rate, {}};
-    for (int i = 0; i < int(rest.size()); ++i)
-        if ((rest[i].head<2>() - spot.center).norm() <= spot.radius) s.particles.push_back(i);
-    if (!s.particles.empty()) spots_.push_back(std::move(s));
+namespace {
+
+bool inSpot(const Eigen::Vector3d& x0, const DiffusionSpot& spot) {
+    return (x0.head<2>() - spot.center).norm() <= spot.radius;
 }
 
-void Diffusion::expandScatter(const SpotScatter& scatter, std::span<const Eigen::Vector3d> rest) {
-    // A spot centred on a random particle is uniform over the sheet, whatever its outline.
+}  // namespace
+
+void Diffusion::addSpot(const DiffusionSpot& spot, const SourceFrame& frame) {
+    Spot s{spot.start, spot.start + spot.duration, spot.rate, {}};
+    double area = 0.0;
+    for (int i = 0; i < int(frame.rest.size()); ++i)
+        if (inSpot(frame.rest[i], spot)) {
+            s.particles.push_back(i);
+            area += frame.areas[i];
+        }
+    if (s.particles.empty()) return;
+    // The dose (theta x area per second) is the seed lattice's: a disc of a few particles
+    // covers more or less than pi r^2, and a finer lattice must not change what it injects.
+    if (frame.seeds) {
+        const Lattice& seeds = *frame.seeds;
+        const auto inside =
+            std::count_if(seeds.positions.begin(), seeds.positions.end(),
+                          [&](const Eigen::Vector3d& x0) { return inSpot(x0, spot); });
+        if (inside > 0) s.rate *= double(inside) * seeds.particleArea / area;
+    }
+    spots_.push_back(std::move(s));
+}
+
+void Diffusion::expandScatter(const SpotScatter& scatter, const SourceFrame& frame) {
+    // A spot centred on a random particle of the seed lattice is uniform over the sheet,
+    // whatever its outline, and lands at the same place at every spacing.
+    const std::span<const Eigen::Vector3d> at =
+        frame.seeds ? std::span<const Eigen::Vector3d>(frame.seeds->positions) : frame.rest;
     for (int k = 0; k < scatter.count; ++k) {
         const double u = uniformFromHash(scatter.seed, 2 * std::uint64_t(k));
         const double v = uniformFromHash(scatter.seed, 2 * std::uint64_t(k) + 1);
-        const int particle = std::min(int(u * double(rest.size())), int(rest.size()) - 1);
+        const int particle = std::min(int(u * double(at.size())), int(at.size()) - 1);
         DiffusionSpot spot;
-        spot.center = rest[particle].head<2>();
+        spot.center = at[particle].head<2>();
         spot.radius = scatter.radius;
         spot.rate = scatter.rate;
         spot.start = scatter.start + v * scatter.spread;
         spot.duration = scatter.duration;
-        addSpot(spot, rest);
+        addSpot(spot, frame);
     }
 }
 

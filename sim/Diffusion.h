@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sim/Bonds.h"
+#include "sim/Lattice.h"
 #include "sim/Params.h"
 
 namespace rend::sim {
@@ -48,8 +49,15 @@ private:
         double start, end, rate;
         std::vector<int> particles;
     };
-    void addSpot(const DiffusionSpot& spot, std::span<const Eigen::Vector3d> rest);
-    void expandScatter(const SpotScatter& scatter, std::span<const Eigen::Vector3d> rest);
+    /// Where sources are placed and measured: the rest positions and per-particle areas, and
+    /// the seed lattice's (sheet.seedSpacing; null at the seed spacing itself).
+    struct SourceFrame {
+        std::span<const Eigen::Vector3d> rest;
+        std::vector<double> areas;
+        const Lattice* seeds = nullptr;
+    };
+    void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
+    void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
     void step(std::vector<double>& theta, const BondFamilies& bonds,
               std::span<const std::uint8_t> alive, double t, double dt);
 

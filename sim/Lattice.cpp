@@ -3,8 +3,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <numbers>
+#include <unordered_map>
 #include <utility>
+
+#include "sim/Random.h"
 
 namespace rend::sim {
 namespace {
@@ -156,7 +161,145 @@ std::size_t estimateParticleCount(const SheetParams& sheet) {
     if (sheet.outline == Outline::Sphere)
         return 10 * (std::size_t(1) << (2 * sphereSubdivisions(sheet))) + 2;
     const Grid g = makeGrid(sheet);
-    return std::size_t(g.columns) * std::size_t(g.rows);
+    if (sheet.outline == Outline::Rectangle) return std::size_t(g.columns) * std::size_t(g.rows);
+    std::size_t count = 0;
+    for (int row = 0; row < g.rows; ++row)
+        for (int column = 0; column < g.columns; ++column)
+            count += insideOutline(sheet, gridPoint(g, sheet.dx, column, row)) ? 1 : 0;
+    return count;
+}
+
+namespace {
+
+/// `value` to three significant digits, rounded down or up, so a chosen spacing reads like one
+/// a person would type (0.00429, not 0.0042946...).
+double threeDigits(double value, bool up) {
+    const int exponent = int(std::floor(std::log10(value))) - 2;
+    const double scale = std::pow(10.0, std::abs(exponent));
+    const double scaled = exponent < 0 ? value * scale : value / scale;
+    const double digits = up ? std::ceil(scaled - 1e-9) : std::floor(scaled + 1e-9);
+    return exponent < 0 ? digits / scale : digits * scale;
+}
+
+}  // namespace
+
+double spacingForParticles(SheetParams sheet, std::size_t target) {
+    if (sheet.outline == Outline::Sphere) {
+        // 10 4^n + 2 vertices after n subdivisions; an edge a hair longer still gives n.
+        int n = 0;
+        while (10 * (std::size_t(1) << (2 * n)) + 2 < target) ++n;
+        const double edge = 4.0 / std::sqrt(10.0 + 2.0 * std::sqrt(5.0)) * sheet.radius;
+        return threeDigits(edge / double(std::size_t(1) << n), true);
+    }
+    // Lattice points per unit area: 1 / dx^2 (square) or 2 / (sqrt(3) dx^2) (hexagonal).
+    const double area = sheet.outline == Outline::Disc
+                            ? std::numbers::pi * sheet.radius * sheet.radius
+                            : sheet.size.x() * sheet.size.y();
+    const double perCell = sheet.lattice == LatticeKind::Square ? 1.0 : 2.0 / std::sqrt(3.0);
+    sheet.dx = threeDigits(std::sqrt(area * perCell / double(target)), false);
+    while (estimateParticleCount(sheet) < target) sheet.dx = threeDigits(sheet.dx * 0.999, false);
+    return sheet.dx;
+}
+
+namespace {
+
+double seedSpacingOf(const SheetParams& sheet) {
+    return sheet.seedSpacing > 0.0 ? sheet.seedSpacing : sheet.dx;
+}
+
+/// Finds, for a point in rest coordinates, the lattice triangle it lies in and its barycentric
+/// weights; triangles are bucketed on a grid of cells one spacing wide.
+class TriangleLocator {
+public:
+    TriangleLocator(const Lattice& lattice, double cell) : lattice_(lattice), cell_(cell) {
+        for (int t = 0; t < int(lattice.triangles.size()); ++t) {
+            Eigen::Vector2d lo = point(lattice.triangles[t][0]), hi = lo;
+            for (int v : lattice.triangles[t]) {
+                lo = lo.cwiseMin(point(v));
+                hi = hi.cwiseMax(point(v));
+            }
+            for (long cy = cellOf(lo.y()); cy <= cellOf(hi.y()); ++cy)
+                for (long cx = cellOf(lo.x()); cx <= cellOf(hi.x()); ++cx)
+                    buckets_[key(cx, cy)].push_back(t);
+        }
+    }
+
+    /// Linear interpolation of per-vertex `values` at p. Outside every triangle (the lattice's
+    /// ragged rim) the least-outside nearby triangle's clamped weights extend it.
+    double interpolate(const Eigen::Vector2d& p, const std::vector<double>& values) const {
+        double bestInside = -std::numeric_limits<double>::infinity();
+        Eigen::Vector3d bestWeights(1, 0, 0);
+        int best = -1;
+        for (long dy = -1; dy <= 1; ++dy)
+            for (long dx = -1; dx <= 1; ++dx) {
+                const auto it = buckets_.find(key(cellOf(p.x()) + dx, cellOf(p.y()) + dy));
+                if (it == buckets_.end()) continue;
+                for (int t : it->second) {
+                    const Eigen::Vector3d w = weights(t, p);
+                    if (w.minCoeff() > bestInside) {
+                        bestInside = w.minCoeff();
+                        bestWeights = w;
+                        best = t;
+                    }
+                }
+            }
+        if (best < 0) return 0.0;
+        const Eigen::Vector3d w = bestWeights.cwiseMax(0.0) / bestWeights.cwiseMax(0.0).sum();
+        const auto& [a, b, c] = lattice_.triangles[best];
+        return w[0] * values[a] + w[1] * values[b] + w[2] * values[c];
+    }
+
+private:
+    Eigen::Vector2d point(int v) const { return lattice_.positions[v].head<2>(); }
+    long cellOf(double coordinate) const { return long(std::floor(coordinate / cell_)); }
+    static std::int64_t key(long cx, long cy) {
+        return (std::int64_t(cx) << 32) ^ (cy & 0xffffffff);
+    }
+
+    Eigen::Vector3d weights(int t, const Eigen::Vector2d& p) const {
+        const auto& [a, b, c] = lattice_.triangles[t];
+        const Eigen::Vector2d e1 = point(b) - point(a), e2 = point(c) - point(a), d = p - point(a);
+        const double det = e1.x() * e2.y() - e1.y() * e2.x();
+        const double u = (d.x() * e2.y() - d.y() * e2.x()) / det;
+        const double v = (e1.x() * d.y() - e1.y() * d.x()) / det;
+        return {1.0 - u - v, u, v};
+    }
+
+    const Lattice& lattice_;
+    double cell_;
+    std::unordered_map<std::int64_t, std::vector<int>> buckets_;
+};
+
+}  // namespace
+
+Lattice seedLattice(const SheetParams& sheet) {
+    SheetParams seeds = sheet;
+    seeds.dx = seedSpacingOf(sheet);
+    return generateLattice(seeds);
+}
+
+std::vector<double> perturbationHeights(const SheetParams& sheet,
+                                        const std::vector<Eigen::Vector3d>& positions) {
+    std::vector<double> height(positions.size(), 0.0);
+    if (sheet.perturbationAmplitude <= 0.0) return height;
+    auto jitter = [&](std::size_t i) {
+        return sheet.perturbationAmplitude *
+               (2.0 * uniformFromHash(sheet.perturbationSeed, std::uint64_t(i)) - 1.0);
+    };
+    const double spacing = seedSpacingOf(sheet);
+    // One value per particle at the seed spacing itself (and on the sphere, which has no flat
+    // lattice to interpolate on).
+    if (spacing == sheet.dx || sheet.outline == Outline::Sphere) {
+        for (std::size_t i = 0; i < positions.size(); ++i) height[i] = jitter(i);
+        return height;
+    }
+    const Lattice coarse = seedLattice(sheet);
+    std::vector<double> values(coarse.positions.size());
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = jitter(i);
+    const TriangleLocator locator(coarse, spacing);
+    for (std::size_t i = 0; i < positions.size(); ++i)
+        height[i] = locator.interpolate(positions[i].head<2>(), values);
+    return height;
 }
 
 }  // namespace rend::sim

@@ -28,4 +28,19 @@ Lattice generateSphere(const SheetParams& sheet);
 /// Number of particles generateLattice would produce, without allocating them.
 std::size_t estimateParticleCount(const SheetParams& sheet);
 
+/// The coarsest spacing, to three significant digits, at which the sheet holds at least
+/// `target` particles (`sheet.dx` is ignored): how `quality = "final"` picks its dx.
+double spacingForParticles(SheetParams sheet, std::size_t target);
+
+/// The seeded out-of-plane jitter at rest of each particle at `positions`, in metres. Its random
+/// values sit on the lattice of spacing `sheet.seedSpacing` (one per particle there) and are
+/// interpolated linearly in between, so a finer lattice of the same sheet samples the same
+/// surface instead of drawing a rougher one.
+std::vector<double> perturbationHeights(const SheetParams& sheet,
+                                        const std::vector<Eigen::Vector3d>& positions);
+
+/// The lattice of spacing `sheet.seedSpacing` (0: dx), on which seeded placements (scattered
+/// spots) are drawn and sources are measured, so they stay the same at every spacing.
+Lattice seedLattice(const SheetParams& sheet);
+
 }  // namespace rend::sim

@@ -31,7 +31,8 @@ Membrane::Membrane(const MembraneParams& params)
     setUpNotches(params);
     assignBoundaries();
     x_ = x0_;
-    perturb(sheet.perturbationAmplitude, sheet.perturbationSeed);
+    const std::vector<double> heights = perturbationHeights(sheet, x0_);
+    for (int i = 0; i < n; ++i) x_[i].z() += heights[i];
     v_.assign(n, Eigen::Vector3d::Zero());
     force_.assign(n, Eigen::Vector3d::Zero());
     if (Diffusion::needed(params)) {
@@ -102,12 +103,6 @@ std::vector<int> Membrane::boundaryParticleCounts() const {
         for (int i = 0; i < particleCount(); ++i)
             if (params_.boundaries[k].region.contains(x0_[i])) ++counts[k];
     return counts;
-}
-
-void Membrane::perturb(double amplitude, std::uint64_t seed) {
-    if (amplitude <= 0.0) return;
-    for (int i = 0; i < particleCount(); ++i)
-        x_[i].z() += amplitude * (2.0 * uniformFromHash(seed, std::uint64_t(i)) - 1.0);
 }
 
 void Membrane::computeForces(std::vector<Eigen::Vector3d>& force) const {

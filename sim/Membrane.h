@@ -149,7 +149,6 @@ private:
     /// Notches: breaks the bonds they cross and has the solver cut the same edges.
     void setUpNotches(const MembraneParams& params);
     void assignBoundaries();
-    void perturb(double amplitude, std::uint64_t seed);
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
     void integrate(double h, double tNext);

@@ -28,6 +28,10 @@ struct SheetParams {
     double thickness = 1e-3;             ///< membrane thickness h [m]
     double perturbationAmplitude = 0.0;  ///< seeded out-of-plane jitter at rest [m]
     std::uint64_t perturbationSeed = 1;
+    /// The spacing of the lattice that seeded random draws refer to (the jitter's values, the
+    /// scattered spots' centres) [m]; 0: dx. The loader sets the preview spacing, so a scene
+    /// keeps its jitter and its spots at every quality.
+    double seedSpacing = 0.0;
 };
 
 /// Axis-aligned box in rest coordinates (x, y); particles whose rest position lies inside

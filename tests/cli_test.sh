@@ -258,6 +258,20 @@ check "absurd gravity is refused at load without inf advice" run 2 run scenes/st
     --set 'forces.gravity=[0,0,-1e300]' --renderer none --out "$tmp/gravity"
 check "absurd gravity message gives no inf or nan" bash -c "! grep -qiE 'inf|nan' '$tmp/stderr'"
 
+# --quality: final picks a spacing giving >= 250,000 particles; the CLI wins over the file.
+check "check --quality final" run 0 check scenes/foil_tear.toml --quality final
+check "final quality says so with its spacing" grep -q "ok (quality final, dx 0.00429 m)" "$tmp/stdout"
+check "final quality holds >= 250,000 particles" \
+    test "$(grep -oE '[0-9]+ particles' "$tmp/stdout" | head -1 | cut -d' ' -f1)" -ge 250000
+check "--quality wins over the file" run 0 check scenes/foil_tear.toml --set sheet.quality=final --quality preview
+check "--quality preview keeps dx" grep -q "ok (quality preview, dx 0.04 m)" "$tmp/stdout"
+check "dx_final overrides the chosen spacing" run 0 check scenes/foil_tear.toml --quality final --set sheet.dx_final=0.02
+check "dx_final is the spacing" grep -q "dx 0.02 m" "$tmp/stdout"
+check "bad --quality refused" run 2 run scenes/stretch.toml --quality ultra --out "$tmp/quality"
+check "bad --quality names both levels" grep -q "expected preview, final, found \"ultra\"" "$tmp/stderr"
+check "bad --quality leaves no output" test ! -e "$tmp/quality"
+check "bad quality in --set refused" run 2 check scenes/stretch.toml --set sheet.quality=ultra
+
 # An --out that names a file is bad input, refused before anything is written.
 touch "$tmp/a_file"
 check "--out naming a file refused" run 2 run scenes/stretch.toml --out "$tmp/a_file"

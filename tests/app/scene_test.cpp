@@ -199,7 +199,7 @@ box = { min = [0.9, 1.9], max = [1.1, 2.1] }
 [[boundary]]
 type = "velocity"
 edge = "top"
-depth = 2
+depth = 0.1
 velocity = [0, 0, 1]
 
 [time]
@@ -275,8 +275,8 @@ INSTANTIATE_TEST_SUITE_P(
                   "-20000. Use e.g. E = 2e4."}},
         BadScene{"bad_missing_dx.toml",
                  "2:1",
-                 {"sheet.dx is missing: expected the particle spacing in metres (in [1e-06, "
-                  "1000]). Add e.g. dx = 0.02 under [sheet]."}},
+                 {"sheet.dx is missing: expected the particle spacing in metres at quality = "
+                  "\"preview\" (in [1e-06, 1000]). Add e.g. dx = 0.02 under [sheet]."}},
         BadScene{"bad_missing_sheet.toml", "1:1", {"sheet.dx is missing"}},
         BadScene{"bad_enum.toml",
                  "5:11",
@@ -774,7 +774,7 @@ rate = 1.0
 
 [[diffusion.edge]]
 edge = "left"
-depth = 2
+depth = 0.1
 value = 1.0
 
 [[diffusion.edge]]
@@ -817,7 +817,8 @@ value = -0.5
 
     ASSERT_EQ(d.edges.size(), 2u);
     EXPECT_DOUBLE_EQ(d.edges[0].value, 1.0);
-    EXPECT_NEAR(d.edges[0].region.max.x(), -0.5 + 0.1, 1e-9) << "depth 2 * dx, like [[boundary]]";
+    EXPECT_NEAR(d.edges[0].region.max.x(), -0.5 + 0.1, 1e-9)
+        << "depth in metres, like [[boundary]]";
     EXPECT_TRUE(std::isinf(d.edges[0].region.min.x()));
     EXPECT_EQ(d.edges[1].region.min, Eigen::Vector2d(0.4, -0.25));
     EXPECT_EQ(d.edges[1].region.max, Eigen::Vector2d(0.5, 0.25));

@@ -1,0 +1,112 @@
+// Issue 12: a finer lattice of the same sheet is the same sheet. Seeded draws (the jitter at rest,
+// scattered spots) sit on the lattice of the seed spacing, and a source injects the same dose
+// (theta x area per second) at every spacing.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/Lattice.h"
+#include "sim/Membrane.h"
+
+using namespace rend::sim;
+
+namespace {
+
+MembraneParams sheetAt(double dx, double seedSpacing) {
+    MembraneParams p;
+    p.sheet.size = {1.0, 1.0};
+    p.sheet.dx = dx;
+    p.sheet.seedSpacing = seedSpacing;
+    p.material.youngsModulus = 2e4;
+    p.material.density = 5000;
+    p.time.dt = 1e-3;
+    return p;
+}
+
+/// sum_i theta_i A_i: the theta injected into an insulated sheet without diffusion.
+double dose(const Membrane& m) {
+    double sum = 0.0;
+    for (int i = 0; i < m.particleCount(); ++i)
+        sum += m.theta()[i] * m.volumes()[i] / m.lattice().particleArea;
+    return sum * m.lattice().particleArea;
+}
+
+double doseAfterTenSteps(MembraneParams p) {
+    Membrane m(p);
+    for (int s = 0; s < 10; ++s) m.step();
+    return dose(m) / p.sheet.thickness;
+}
+
+}  // namespace
+
+TEST(Resolution, ASpotInjectsTheSameDoseAtASixthOfTheSpacing) {
+    for (const double radius : {0.05, 0.07, 0.13}) {
+        MembraneParams coarse = sheetAt(0.04, 0.04), fine = sheetAt(0.04 / 6, 0.04);
+        for (MembraneParams* p : {&coarse, &fine})
+            p->diffusion.spots = {DiffusionSpot{{0.013, -0.021}, radius, 1.0, 0.0, 1.0}};
+        const double a = doseAfterTenSteps(coarse), b = doseAfterTenSteps(fine);
+        EXPECT_NEAR(b / a, 1.0, 0.02) << "radius " << radius;
+        // Without the seed lattice the fine one injects about the disc's own area instead.
+        MembraneParams own = sheetAt(0.04 / 6, 0.0);
+        own.diffusion.spots = fine.diffusion.spots;
+        std::printf(
+            "[resolution] spot r = %.2f m: dose %.5f (dx 0.04) %.5f (dx 0.04/6, seeded) "
+            "%.5f (dx 0.04/6, unseeded), pi r^2 x 0.01 s = %.5f\n",
+            radius, a, b, doseAfterTenSteps(own), M_PI * radius * radius * 0.01);
+    }
+}
+
+TEST(Resolution, ScatteredSpotsLandOnTheSameCentresAtEverySpacing) {
+    MembraneParams coarse = sheetAt(0.04, 0.04), fine = sheetAt(0.01, 0.04);
+    for (MembraneParams* p : {&coarse, &fine})
+        p->diffusion.scatters = {SpotScatter{20, 0.06, 1.0, 0.0, 0.0, 1.0, 11}};
+    const double a = doseAfterTenSteps(coarse), b = doseAfterTenSteps(fine);
+    EXPECT_NEAR(b / a, 1.0, 0.02);
+    // The hottest particle of the fine sheet is where the coarse one's is (overlapping spots).
+    Membrane mc(coarse), mf(fine);
+    for (int s = 0; s < 10; ++s) mc.step(), mf.step();
+    auto hottest = [](const Membrane& m) {
+        int best = 0;
+        for (int i = 1; i < m.particleCount(); ++i)
+            if (m.theta()[i] > m.theta()[best]) best = i;
+        return m.restPositions()[best];
+    };
+    EXPECT_LT((hottest(mc) - hottest(mf)).norm(), 0.1);
+}
+
+TEST(Resolution, TheJitterIsTheSameSurfaceSampledFiner) {
+    SheetParams coarse = sheetAt(0.04, 0.04).sheet;
+    coarse.perturbationAmplitude = 1e-3;
+    coarse.perturbationSeed = 3;
+    SheetParams fine = coarse;
+    fine.dx = 0.01;
+    const Lattice lc = generateLattice(coarse), lf = generateLattice(fine);
+    const std::vector<double> zc = perturbationHeights(coarse, lc.positions);
+    const std::vector<double> zf = perturbationHeights(fine, lf.positions);
+    auto steepest = [](const Lattice& l, const std::vector<double>& z, double dx) {
+        double slope = 0.0;
+        // Inside the coarse lattice's rim, where the heights are interpolated, not extended.
+        auto inner = [&](int v) {
+            return l.positions[v].head<2>().lpNorm<Eigen::Infinity>() < 0.44;
+        };
+        for (const auto& [a, b, c] : l.triangles)
+            if (inner(a) && inner(b) && inner(c))
+                slope = std::max({slope, std::abs(z[a] - z[b]), std::abs(z[b] - z[c])});
+        return slope / dx;
+    };
+    SheetParams unseeded = fine;
+    unseeded.seedSpacing = 0.0;
+    const double seeded = steepest(lf, zf, fine.dx), own = steepest(lc, zc, coarse.dx);
+    const double rough = steepest(lf, perturbationHeights(unseeded, lf.positions), fine.dx);
+    std::printf(
+        "[resolution] jitter's steepest slope: %.4f (dx 0.04), %.4f (dx 0.01, seeded), "
+        "%.4f (dx 0.01, one value per particle)\n",
+        own, seeded, rough);
+    // Interpolated within the coarse triangles the slopes stay the coarse ones' (a triangle's
+    // gradient exceeds its edges' by at most 2 / sqrt(3)), where one value per fine particle
+    // would make them four times as steep and strain the bonds at rest.
+    EXPECT_LT(seeded, 2.0 * own);
+    EXPECT_GT(rough, 3.0 * own);
+    for (const double z : zf) EXPECT_LE(std::abs(z), coarse.perturbationAmplitude);
+}

@@ -23,6 +23,7 @@ struct Scene {
     render::RenderSettings render;
     RendererKind renderer = RendererKind::Osmesa;
     bool writeStats = true;
+    bool writeExr = false;  ///< [output] exr: frames/frame_N.exr beside each PNG (Embree only)
     std::vector<ExportFormat> exports;  ///< [output] export, in the order given
 
     /// Whether a run estimated beyond the cost limit may start ([time] allow_slow).

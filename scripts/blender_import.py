@@ -187,7 +187,7 @@ def render_exr_series(scene, counts, exr_dir):
         best, best_cpu = math.inf, math.inf
         # Short renders are repeated: on a shared machine the minimum is the honest figure.
         # CPU seconds (all threads) are printed too: robust when other jobs share the cores.
-        for _ in range(3 if count <= 64 else 1):
+        for _ in range(3 if count <= 16 else 1):
             start, start_cpu = time.perf_counter(), time.process_time()
             bpy.ops.render.render()
             best = min(best, time.perf_counter() - start)

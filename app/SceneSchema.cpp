@@ -373,8 +373,8 @@ constexpr Param kOutput[] = {
      {},
      "false",
      "whether to write frames/frame_N.exr beside each PNG: linear half-float R, G, B before the "
-     "tone curve, and Z (camera distance, float) and N.X, N.Y, N.Z (world normal) of the first "
-     "hit; path tracer only",
+     "tone curve, and Z (camera distance, float), N.X, N.Y, N.Z (world normal) and theta of the "
+     "first hit; path tracer only",
      "true"},
     {"export",
      T::ChoiceList,

@@ -293,6 +293,7 @@ struct SurfaceHit {
     Vec3 geometricNormal;  ///< unit, facing the incoming ray
     Vec3 shadingNormal;    ///< unit, on the same side as geometricNormal
     Vec3 albedo;
+    float theta = 0.0f;  ///< the mesh's diffusing quantity, when it has one
     bool ground = false;
     std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the disc or triangle hit
 };
@@ -378,6 +379,8 @@ struct Tracer {
     float sunCosMax = 1.0f;
     Frame sunFrame{Vec3::UnitZ()};
 
+    bool hasTheta() const { return mesh && !mesh->theta.empty(); }
+
     Vec3 environment(const Vec3& d) const {
         if (!sky) return background;
         const float t = std::clamp(d.z(), 0.0f, 1.0f);
@@ -431,6 +434,8 @@ void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
         const auto& c = mesh->colors;
         hit.albedo =
             c.empty() ? defaultAlbedo : Vec3(w0 * c[tri[0]] + h.u * c[tri[1]] + h.v * c[tri[2]]);
+        const auto& th = mesh->theta;
+        hit.theta = th.empty() ? 0.0f : w0 * th[tri[0]] + h.u * th[tri[1]] + h.v * th[tri[2]];
     } else {
         hit.shadingNormal = safeNormalized(splats->normals[h.primID], ng);
         hit.albedo = splats->colors.empty() ? defaultAlbedo : splats->colors[h.primID];
@@ -666,6 +671,7 @@ void firstHitLayers(const Tracer& tracer, const CameraRays& camera, int x, int y
     }
     layers.depth[pixel] = hit.t;
     for (int k = 0; k < 3; ++k) layers.normal[pixel * 3 + k] = hit.shadingNormal[k];
+    if (!layers.theta.empty()) layers.theta[pixel] = hit.ground ? 0.0f : hit.theta;
 }
 
 }  // namespace
@@ -858,6 +864,7 @@ Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera
         *layers = FrameLayers{camera.width, camera.height, {}, {}, {}, {}};
         layers->depth.resize(pixels);
         layers->normal.resize(pixels * 3);
+        if (tracer.hasTheta()) layers->theta.resize(pixels);
     }
     // Counted per pixel, so the total is the same integer sum in any tile order.
     std::vector<long long> pixelRays(pixels, 0);

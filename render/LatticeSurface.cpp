@@ -116,6 +116,7 @@ void addWalls(Mesh& mesh, std::uint32_t sheetVertices,
             mesh.positions.push_back(mesh.positions[face]);
             mesh.normals.push_back(normals[v]);
             mesh.colors.push_back(mesh.colors[v]);
+            if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
         }
         return wall[v];
     };
@@ -140,6 +141,7 @@ void extrude(Mesh& mesh, double thickness) {
         mesh.positions[v] += half * mesh.normals[v];
         mesh.normals.push_back(-mesh.normals[v]);
         mesh.colors.push_back(mesh.colors[v]);
+        if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
     }
     const std::size_t faces = mesh.triangles.size();
     for (std::size_t t = 0; t < faces; ++t) {
@@ -238,6 +240,10 @@ Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& se
     mesh.colors = particleColors(frame, settings);
     mesh.colors.reserve(mesh.positions.size());
     for (int p : corners.copyOf) mesh.colors.push_back(mesh.colors[p]);
+    if (!frame.theta.empty()) {  // for the EXR's theta layer
+        mesh.theta.assign(frame.theta.begin(), frame.theta.end());
+        for (int p : corners.copyOf) mesh.theta.push_back(mesh.theta[p]);
+    }
     if (settings.thickness > 0.0) extrude(mesh, settings.thickness);
     return mesh;
 }

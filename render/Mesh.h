@@ -14,6 +14,7 @@ struct Mesh {
     std::vector<Eigen::Vector3f> positions;
     std::vector<Eigen::Vector3f> normals;  ///< per vertex, unit length
     std::vector<Eigen::Vector3f> colors;   ///< per vertex, linear RGB in [0,1]
+    std::vector<float> theta;  ///< per vertex, the diffusing quantity; empty when there is none
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 
@@ -24,7 +25,8 @@ inline void checkMesh(const Mesh& mesh, std::string_view who) {
     const auto fail = [&](const char* what) {
         throw std::invalid_argument(std::string(who) + ": " + what);
     };
-    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n))
+    if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n) ||
+        (!mesh.theta.empty() && mesh.theta.size() != n))
         fail("mesh attribute arrays differ in length");
     for (const auto& t : mesh.triangles)
         for (std::uint32_t v : t)

@@ -114,6 +114,21 @@ TEST(EmbreeLayers, DepthAndNormalAreThoseOfTheFirstHitAlongThePixelCentre) {
     EXPECT_NEAR(layers.normal[3 * middle + 2], 1.0f, 1e-5f);  // faces the camera, world +z
     EXPECT_EQ(layers.depth[0], FrameLayers::kNoHit);          // the corner misses the square
     EXPECT_EQ(layers.normal[0], 0.0f);
+    EXPECT_TRUE(layers.theta.empty()) << "a mesh without theta has no theta layer";
+}
+
+TEST(EmbreeLayers, ThetaIsInterpolatedAtTheFirstHit) {
+    RenderSettings settings = lookingDown(2.0);
+    settings.pathTracing.samplesPerPixel = 1;
+    Mesh mesh = square(0.5, 0.3, 0.7f);
+    // Corners (-, -), (+, -), (+, +), (-, +): theta = 1 + x + y at the corners, linear inside.
+    mesh.theta = {0.5f, 1.0f, 1.5f, 1.0f};
+    EmbreeRenderer renderer;
+    FrameLayers layers;
+    renderer.render(mesh, settings, &layers);
+    ASSERT_EQ(layers.theta.size(), std::size_t(kSize) * kSize);
+    EXPECT_NEAR(layers.theta[std::size_t(kMiddle) * kSize + kMiddle], 1.0f, 1e-4f);
+    EXPECT_EQ(layers.theta[0], 0.0f);  // the ground
 }
 
 TEST(ExrWriter, WritesAndReadsBackEveryChannelWithItsValues) {

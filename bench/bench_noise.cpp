@@ -1,12 +1,13 @@
 // Noise against time of the Embree path tracer, for scripts/bench_cycles.sh (which compares it
 // with Blender Cycles at equal RMSE). Two commands:
 //
-//   bench_noise render SCENE FRAME WIDTH HEIGHT OUT_DIR SPP...
+//   bench_noise render SCENE FRAME WIDTH HEIGHT OUT_DIR SPP... ref=SPP
 //       simulates SCENE to FRAME once, exports its lattice mesh (OUT_DIR/meshes/frame_N.ply and
 //       a run.json for scripts/blender_import.py), then renders it at each SPP into
 //       OUT_DIR/rend_SPP.exr and prints "rend spp=S seconds=T" (the best of a few renders when
-//       they are short). T counts everything from handing the mesh to a new renderer
-//       (device, BVH build) to the linear image; not the simulation, the PNG or the EXR.
+//       they are short); ref=SPP renders the reference with another seed. T counts everything from
+//       handing the mesh to a new renderer (device, BVH build) to the linear image; not the
+//       simulation, the PNG or the EXR.
 //   bench_noise rmse REFERENCE.exr IMAGE.exr...
 //       prints "rmse IMAGE VALUE": the root-mean-square difference of R, G and B against the
 //       reference, each value clamped to [0, 1] first (the display range: noise in a highlight
@@ -89,8 +90,12 @@ int renderCommand(int argc, char** argv) {
     std::ofstream(out / "run.json") << "{\"resolved_scene\": " << scene.resolvedJson << "}\n";
     std::printf("rend threads=%d triangles=%zu\n", omp_get_max_threads(), mesh.triangles.size());
     for (int k = 7; k < argc; ++k) {
-        const int spp = std::atoi(argv[k]);
-        const rend::render::RenderSettings& settings = scene.render;
+        // "ref=N": the reference, with another seed, so that its noise is independent of the
+        // measured images' (the same seed would share their first samples).
+        const bool reference = std::string(argv[k]).rfind("ref=", 0) == 0;
+        const int spp = std::atoi(argv[k] + (reference ? 4 : 0));
+        rend::render::RenderSettings settings = scene.render;
+        settings.pathTracing.seed = reference ? 1 : 0;
         rend::render::FrameLayers layers;
         rend::render::Image image;
         Timing best = timeRender(mesh, settings, spp, image, layers);

@@ -368,7 +368,8 @@ struct Tracer {
     Vec3 defaultAlbedo;
     Bsdf material;
     int maxDepth = 1;
-    float epsilon = 1e-4f;  ///< ray origin offset, relative to the scene's size
+    std::uint64_t seedKey = 0;  ///< XORed into the pixel index above any pixel's bits
+    float epsilon = 1e-4f;      ///< ray origin offset, relative to the scene's size
     bool ground = false;
     float groundZ = 0.0f;
     Vec3 groundColor;
@@ -604,6 +605,7 @@ Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
     tr.material.alpha = std::max(kMinAlpha, float(pt.roughness * pt.roughness));
     tr.material.transmission = std::clamp(float(pt.transmission), 0.0f, 1.0f);
     tr.maxDepth = std::max(1, pt.maxDepth);
+    tr.seedKey = std::uint64_t(pt.seed) << 40;  // images have fewer than 2^40 pixels
     tr.epsilon = 1e-4f * sceneScale(geometry, s);
     tr.ground = s.ground;
     tr.groundZ = float(s.groundHeight);
@@ -848,7 +850,7 @@ Vec3 EmbreeRenderer::Impl::samplePixel(const Tracer& tracer, const CameraRays& c
     const std::size_t pixel = std::size_t(y) * camera.width + x;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (int s = 0; s < spp; ++s) {
-        Sampler rng(pixel, std::uint32_t(s), std::uint32_t(spp));
+        Sampler rng(pixel ^ tracer.seedKey, std::uint32_t(s), std::uint32_t(spp));
         const auto [jx, jy] = rng.next2D();
         sum += tracer.radiance(camera.origin, camera.direction(x, y, jx, jy), rng, rays)
                    .cast<double>();

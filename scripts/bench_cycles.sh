@@ -4,7 +4,9 @@
 #   scripts/bench_cycles.sh [SCENE] [FRAME] [WIDTH] [HEIGHT] [REFERENCE_SPP]
 # Each renderer renders the frame at several sample counts and once at REFERENCE_SPP (1024 by
 # default); noise is the RMSE of linear R, G, B (clamped to [0, 1], the display range) against
-# the renderer's OWN reference, corrected for the reference's own noise (below). Time to a
+# the renderer's OWN reference, rendered with another seed (so its noise is independent of the
+# measured images'; with the same seed both renderers would reuse their first samples) and
+# corrected for that noise (below). Time to a
 # target RMSE is interpolated log-log between the measured points; the targets are Cycles' RMSE
 # at 16 and 64 spp. Prints the table and the ratio Cycles time / rend time, for wall seconds
 # and for CPU seconds (all threads; the robust figure when other jobs share the cores).
@@ -23,7 +25,7 @@ command -v blender >/dev/null || { echo "bench_cycles: blender not installed (ap
 tmp=$(mktemp -d)
 [[ -n ${KEEP_BENCH:-} ]] && echo "bench_cycles: keeping $tmp" || trap 'rm -rf "$tmp"' EXIT
 OMP_WAIT_POLICY=passive build/bench_noise render "$scene" "$frame" "$width" "$height" "$tmp" \
-    $rend_spp "$reference" > "$tmp/rend.txt"
+    $rend_spp "ref=$reference" > "$tmp/rend.txt"
 blender_run() {
     blender -b --factory-startup -P scripts/blender_import.py -- "$tmp" --frame "$frame" \
         --width "$width" --height "$height" --exr-dir "$tmp" "$@" 2>/dev/null | grep '^cycles '

@@ -20,8 +20,8 @@ With --exr-dir, --samples takes a comma-separated list: each count is rendered i
 DIR/cycles_S.exr (linear RGB, before any view transform) and printed as
 `cycles spp=S seconds=T`, T being bpy.ops.render.render alone (scene sync, BVH build and path
 tracing; not Blender's start-up, the import or the file write). --reference turns Cycles'
-adaptive sampling off (every pixel gets all samples); otherwise Cycles keeps its default
-adaptive sampling.
+adaptive sampling off (every pixel gets all samples) and uses another seed; otherwise Cycles
+keeps its default adaptive sampling.
 """
 import argparse
 import json
@@ -215,6 +215,9 @@ def main():
     scene.cycles.device = "CPU"
     scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = not args.reference
+    # The reference's noise must be independent of the measured images': with one seed, Cycles'
+    # first N samples of the reference would be those of the N-sample image.
+    scene.cycles.seed = 1 if args.reference else 0
     depth = render.get("max_depth", 4)
     for bounces in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
         setattr(scene.cycles, bounces, depth)

@@ -165,3 +165,24 @@ TEST(ExrWriter, RefusesALayerOfTheWrongSize) {
     layers.depth.assign(5, 0.0f);
     EXPECT_THROW(rend::render::writeExrAtomic(layers, "unused.exr"), std::invalid_argument);
 }
+
+TEST(EmbreeLayers, AnotherSeedGivesOtherNoiseAroundTheSameMean) {
+    RenderSettings settings = lookingDown(2.0);
+    settings.sun.direction = Eigen::Vector3d(-0.3, 0.2, 1.0);  // the square's shadow is in view
+    settings.pathTracing.samplesPerPixel = 8;
+    const Mesh mesh = square(1.0, 0.4, 0.7f);
+    EmbreeRenderer renderer;
+    FrameLayers first, second;
+    renderer.render(mesh, settings, &first);
+    settings.pathTracing.seed = 1;
+    renderer.render(mesh, settings, &second);
+    double meanFirst = 0.0, meanSecond = 0.0;
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < first.rgb.size(); ++i) {
+        meanFirst += first.rgb[i] / double(first.rgb.size());
+        meanSecond += second.rgb[i] / double(first.rgb.size());
+        differ += first.rgb[i] != second.rgb[i];
+    }
+    EXPECT_GT(differ, first.rgb.size() / 10);
+    EXPECT_NEAR(meanFirst, meanSecond, 0.01 * meanFirst);
+}

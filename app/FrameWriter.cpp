@@ -4,7 +4,9 @@
 #include <cstdio>
 
 #include "app/Pipeline.h"
+#include "app/SceneError.h"
 #include "render/EmbreeRenderer.h"
+#include "render/ExrWriter.h"
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
 #include "render/OsmesaRenderer.h"
@@ -52,7 +54,14 @@ struct FrameWriter::Parts {
 };
 
 FrameWriter::FrameWriter(const Scene& scene, const std::filesystem::path& outDir)
-    : scene_(scene), outDir_(outDir), parts_(std::make_unique<Parts>()) {}
+    : scene_(scene), outDir_(outDir), parts_(std::make_unique<Parts>()) {
+    if (scene.writeExr && scene.renderer == RendererKind::Osmesa) {
+        throw SceneError(scene.locationOf("output.exr") +
+                         ": error: output.exr: expected the path tracer, found the osmesa "
+                         "renderer, whose frames have no linear radiance or first-hit layers. "
+                         "Use --renderer embree, or set exr = false.");
+    }
+}
 
 FrameWriter::~FrameWriter() = default;
 
@@ -63,6 +72,7 @@ bool FrameWriter::active() const {
 std::vector<std::string> FrameWriter::plannedFiles(int frame) const {
     std::vector<std::string> names;
     if (scene_.renderer != RendererKind::None) names.push_back("frames/" + frameName(frame, "png"));
+    if (writesExr()) names.push_back("frames/" + frameName(frame, "exr"));
     for (ExportFormat format : scene_.exports) {
         names.push_back(exportName(frame, format));
         if (format == ExportFormat::Obj) names.push_back("meshes/" + frameName(frame, "mtl"));
@@ -86,11 +96,16 @@ render::Geometry FrameWriter::buildSurface(const sim::FrameView& view) {
     return p.lattice->build(view, scene_.render);
 }
 
-render::Image FrameWriter::renderImage(const render::Geometry& geometry) {
+bool FrameWriter::writesExr() const {
+    return scene_.writeExr && scene_.renderer == RendererKind::Embree;
+}
+
+render::Image FrameWriter::renderImage(const render::Geometry& geometry,
+                                       render::FrameLayers* layers) {
     Parts& p = *parts_;
     if (scene_.renderer == RendererKind::Embree) {
         if (!p.embree) p.embree = std::make_unique<render::EmbreeRenderer>();
-        return p.embree->render(geometry, scene_.render);
+        return p.embree->render(geometry, scene_.render, layers);
     }
     if (!p.osmesa) p.osmesa = std::make_unique<render::OsmesaRenderer>();
     render::Mesh scratch;
@@ -129,13 +144,19 @@ void FrameWriter::write(const sim::FrameView& view, StageTimes& seconds,
     seconds.surface += secondsSince(t0);
     if (scene_.renderer != RendererKind::None) {
         t0 = Clock::now();
-        const render::Image image = renderImage(geometry);
+        render::FrameLayers layers;
+        const render::Image image = renderImage(geometry, writesExr() ? &layers : nullptr);
         seconds.render += secondsSince(t0);
         t0 = Clock::now();
         std::filesystem::create_directories(outDir_ / "frames");
         const std::string name = "frames/" + frameName(view.frame, "png");
         render::writePngAtomic(image, outDir_ / name);
         written.push_back(name);
+        if (writesExr()) {
+            const std::string exr = "frames/" + frameName(view.frame, "exr");
+            render::writeExrAtomic(layers, outDir_ / exr);
+            written.push_back(exr);
+        }
         seconds.write += secondsSince(t0);
     }
     t0 = Clock::now();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/Scene.h"
+#include "render/ExrWriter.h"
 #include "render/Geometry.h"
 #include "render/Image.h"
 #include "sim/FrameView.h"
@@ -20,6 +21,7 @@ struct StageTimes;
 
 class FrameWriter {
 public:
+    /// Throws SceneError when the scene asks for EXR frames from the osmesa renderer.
     FrameWriter(const Scene& scene, const std::filesystem::path& outDir);
     ~FrameWriter();
 
@@ -35,7 +37,9 @@ public:
 
 private:
     render::Geometry buildSurface(const sim::FrameView& view);
-    render::Image renderImage(const render::Geometry& geometry);
+    bool writesExr() const;  ///< [output] exr with the path tracer
+    /// The frame's PNG image; with the path tracer also its EXR layers when `layers` is given.
+    render::Image renderImage(const render::Geometry& geometry, render::FrameLayers* layers);
     void exportFrame(const sim::FrameView& view, const render::Geometry& geometry,
                      std::vector<std::string>& written);
 

@@ -66,7 +66,7 @@ bool StatsWriter::finish() {
 
 bool isRunOutputName(const std::string& name) {
     static const std::regex kNames(
-        R"(stats\.csv|frames/frame_[0-9]{4,9}\.png|meshes/frame_[0-9]{4,9}\.(ply|obj|mtl|glb)|)"
+        R"(stats\.csv|frames/frame_[0-9]{4,9}\.(png|exr)|meshes/frame_[0-9]{4,9}\.(ply|obj|mtl|glb)|)"
         R"(vdb/frame_[0-9]{4,9}\.vdb)");
     return std::regex_match(name, kNames);
 }

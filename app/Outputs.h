@@ -39,8 +39,8 @@ private:
 };
 
 /// Whether `name` (relative to the output folder) is one rend writes: stats.csv,
-/// frames/frame_N.png, meshes/frame_N.{ply,obj,mtl,glb} or vdb/frame_N.vdb. Only such names are
-/// ever removed, whatever a run.json lists.
+/// frames/frame_N.{png,exr}, meshes/frame_N.{ply,obj,mtl,glb} or vdb/frame_N.vdb. Only such names
+/// are ever removed, whatever a run.json lists.
 bool isRunOutputName(const std::string& name);
 
 /// The files the run.json in `outDir` lists under "files" that rend writes (isRunOutputName);

@@ -29,6 +29,7 @@ struct Scene {
     render::RenderSettings render;
     RendererKind renderer = RendererKind::Osmesa;
     bool writeStats = true;
+    bool writeExr = false;  ///< [output] exr: frames/frame_N.exr beside each PNG (Embree only)
     std::vector<ExportFormat> exports;  ///< [output] export, in the order given
 
     Quality quality = Quality::Preview;

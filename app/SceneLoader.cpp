@@ -609,6 +609,7 @@ void readRender(const TableReader& root, const sim::SheetParams& sheet, Scene& s
 void readOutput(const TableReader& root, Scene& scene) {
     const TableReader t = root.section("output");
     scene.writeStats = t.boolean("stats").value_or(scene.writeStats);
+    scene.writeExr = t.boolean("exr").value_or(scene.writeExr);
     const toml::node* list = t.find("export");
     if (!list) return;
     const std::span<const std::string_view> formats = t.param("export").names;

@@ -418,6 +418,14 @@ constexpr Param kRender[] = {
 
 constexpr Param kOutput[] = {
     {"stats", T::Boolean, {}, "true", "whether to write stats.csv", "true"},
+    {"exr",
+     T::Boolean,
+     {},
+     "false",
+     "whether to write frames/frame_N.exr beside each PNG: linear half-float R, G, B before the "
+     "tone curve, and Z (camera distance, float), N.X, N.Y, N.Z (world normal) and theta of the "
+     "first hit; path tracer only",
+     "true"},
     {"export",
      T::ChoiceList,
      {},

@@ -295,6 +295,7 @@ struct SurfaceHit {
     Vec3 albedo;
     float alpha = 0.0f;         ///< the look's GGX alpha here (sheet hits only)
     float transmission = 0.0f;  ///< the look's transmission here (sheet hits only)
+    float theta = 0.0f;         ///< the mesh's diffusing quantity, when it has one
     bool ground = false;
     std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the disc or triangle hit
 };
@@ -373,7 +374,8 @@ struct Tracer {
     std::vector<std::array<float, 2>> layerParams;
     ToneMapping tone;
     int maxDepth = 1;
-    float epsilon = 1e-4f;  ///< ray origin offset, relative to the scene's size
+    std::uint64_t seedKey = 0;  ///< XORed into the pixel index above any pixel's bits
+    float epsilon = 1e-4f;      ///< ray origin offset, relative to the scene's size
     bool ground = false;
     float groundZ = 0.0f;
     Vec3 groundColor;
@@ -384,10 +386,18 @@ struct Tracer {
     float sunCosMax = 1.0f;
     Frame sunFrame{Vec3::UnitZ()};
 
+    bool hasTheta() const { return mesh && !mesh->theta.empty(); }
+
     Vec3 environment(const Vec3& d) const {
         if (!sky) return background;
         const float t = std::clamp(d.z(), 0.0f, 1.0f);
         return horizon + (zenith - horizon) * t;
+    }
+
+    /// The environment's mean over cosine-distributed directions about +z, i.e. its irradiance
+    /// on an upward-facing plane over pi: (1/pi) int (h + (z - h) cos) cos dw = h + 2/3 (z - h).
+    Vec3 skyIrradianceOverPi() const {
+        return sky ? Vec3(horizon + (zenith - horizon) * (2.0f / 3.0f)) : background;
     }
 
     float groundDistance(const Vec3& origin, const Vec3& direction) const {
@@ -432,6 +442,8 @@ void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
         const auto& c = mesh->colors;
         hit.albedo =
             c.empty() ? defaultAlbedo : Vec3(w0 * c[tri[0]] + h.u * c[tri[1]] + h.v * c[tri[2]]);
+        const auto& th = mesh->theta;
+        hit.theta = th.empty() ? 0.0f : w0 * th[tri[0]] + h.u * th[tri[1]] + h.v * th[tri[2]];
         if (layerParams.empty()) return;
         const auto& l = layerParams;
         hit.alpha = w0 * l[tri[0]][0] + h.u * l[tri[1]][0] + h.v * l[tri[2]][0];
@@ -537,22 +549,41 @@ Vec3 clampContribution(const Vec3& c, int depth) {
 
 /// Unidirectional path tracing: the sun by next-event estimation at every vertex, the
 /// environment when a path escapes (the sun is not part of it, so nothing is counted twice).
+///
+/// Sky light on the ground plane uses a control variate: the ground's cosine-sampled bounce
+/// would see the sky gradient L(d), whose cosine-weighted mean is known in closed form
+/// (skyIrradianceOverPi). The ground vertex adds that mean, and the bounce then contributes
+/// only what differs from an open sky: nothing when it escapes, and its radiance minus L(d)
+/// when it hits the sheet. The estimate stays unbiased (the mean of L(d) over the sampled
+/// directions is exactly what is added), and the open ground, most of a frame's pixels, loses
+/// all of its sky noise: L varies eightfold between zenith and horizon.
 Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays) const {
     Vec3 result = Vec3::Zero();
     Vec3 throughput = Vec3::Ones();
     std::uint32_t fromPrim = RTC_INVALID_GEOMETRY_ID;
+    bool skyControl = false;  // the last vertex already added the open sky's mean
     for (int depth = 0;; ++depth) {
         SurfaceHit hit;
         if (!intersect(origin, direction, fromPrim, hit, rays)) {
-            result += clampContribution(throughput.cwiseProduct(environment(direction)), depth);
+            if (!skyControl)
+                result += clampContribution(throughput.cwiseProduct(environment(direction)), depth);
             break;
         }
+        if (skyControl) result -= throughput.cwiseProduct(environment(direction));
+        skyControl = false;
         if (depth == maxDepth) break;
         const Bsdf bsdf = bsdfAt(hit);
         const Frame frame(hit.shadingNormal);
         const Vec3 wo = frame.toLocal(-direction);
         result += clampContribution(
             throughput.cwiseProduct(sunLight(hit, bsdf, frame, wo, rng, rays)), depth);
+        if (hit.ground && hit.geometricNormal.z() > 0.0f) {
+            // The ground's bounce is cosine-distributed about +z with weight = its albedo.
+            result += clampContribution(
+                throughput.cwiseProduct(bsdf.albedo).cwiseProduct(skyIrradianceOverPi()),
+                depth + 1);
+            skyControl = true;
+        }
         Vec3 wi, weight;
         if (!bsdf.sample(wo, rng, wi, weight)) break;
         direction = frame.toWorld(wi).normalized();
@@ -618,6 +649,7 @@ Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
     tr.layerParams = layerParams(geometry, s);
     tr.tone = s.tone;
     tr.maxDepth = std::max(1, pt.maxDepth);
+    tr.seedKey = std::uint64_t(pt.seed) << 40;  // images have fewer than 2^40 pixels
     tr.epsilon = 1e-4f * sceneScale(geometry, s);
     tr.ground = s.ground;
     tr.groundZ = float(s.groundHeight);
@@ -640,22 +672,48 @@ Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
     return tr;
 }
 
+/// Primary rays. cameraRayDirection is linear in the image coordinates, so it is evaluated
+/// three times per frame and each ray is forward + (x, y) offsets in float: no tan() or double
+/// arithmetic per sample.
 struct CameraRays {
     Vec3 origin;
-    detail::ViewBasis basis;
-    double fovY = 40.0;
-    double aspect = 1.0;
+    Vec3 topLeft, stepX, stepY;  ///< unnormalised direction at pixel (0, 0)'s corner, per pixel
     int width = 1;
     int height = 1;
 
+    CameraRays(const RenderSettings& s) : width(s.width), height(s.height) {
+        origin = toFloat(s.camera.position);
+        const auto basis = detail::viewBasis(s.camera.position, s.camera.lookAt, s.camera.up);
+        const double aspect = double(width) / height;
+        auto at = [&](double ndcX, double ndcY) {
+            return detail::cameraRayDirection(basis, s.camera.fovYDegrees, aspect, ndcX, ndcY);
+        };
+        // Image rows run top-down: y grows as ndcY falls.
+        topLeft = toFloat(at(-1.0, 1.0));
+        stepX = toFloat((at(1.0, 1.0) - at(-1.0, 1.0)) / width);
+        stepY = toFloat((at(-1.0, -1.0) - at(-1.0, 1.0)) / height);
+    }
+
     Vec3 direction(int x, int y, float jx, float jy) const {
-        const double ndcX = 2.0 * (x + jx) / width - 1.0;
-        const double ndcY = 1.0 - 2.0 * (y + jy) / height;  // image rows run top-down
-        return detail::cameraRayDirection(basis, fovY, aspect, ndcX, ndcY)
-            .normalized()
-            .cast<float>();
+        return (topLeft + (float(x) + jx) * stepX + (float(y) + jy) * stepY).normalized();
     }
 };
+
+/// The EXR's first-hit layers of pixel (x, y), from one ray through its centre: depth and normal
+/// are not averaged over the pixel's samples, which would invent surfaces between two depths at
+/// a silhouette.
+void firstHitLayers(const Tracer& tracer, const CameraRays& camera, int x, int y, std::size_t pixel,
+                    FrameLayers& layers, long long& rays) {
+    SurfaceHit hit;
+    const Vec3 d = camera.direction(x, y, 0.5f, 0.5f);
+    if (!tracer.intersect(camera.origin, d, RTC_INVALID_GEOMETRY_ID, hit, rays)) {
+        layers.depth[pixel] = FrameLayers::kNoHit;
+        return;
+    }
+    layers.depth[pixel] = hit.t;
+    for (int k = 0; k < 3; ++k) layers.normal[pixel * 3 + k] = hit.shadingNormal[k];
+    if (!layers.theta.empty()) layers.theta[pixel] = hit.ground ? 0.0f : hit.theta;
+}
 
 }  // namespace
 
@@ -684,9 +742,9 @@ struct EmbreeRenderer::Impl {
     void createSplats(const Splats& splats);
     void copyVertices(const Geometry& geometry);
     void refit();
-    Image trace(const Tracer& tracer, const CameraRays& camera, int spp);
-    long long traceTile(const Tracer& tracer, const CameraRays& camera, int spp, int tile,
-                        std::vector<std::uint8_t>& rgb) const;
+    Image trace(const Tracer& tracer, const CameraRays& camera, int spp, FrameLayers* layers);
+    Vec3 samplePixel(const Tracer& tracer, const CameraRays& camera, int spp, int x, int y,
+                     long long& rays) const;
 };
 
 EmbreeRenderer::Impl::~Impl() {
@@ -806,40 +864,66 @@ void EmbreeRenderer::Impl::refit() {
     check("refitting the BVH");
 }
 
-long long EmbreeRenderer::Impl::traceTile(const Tracer& tracer, const CameraRays& camera, int spp,
-                                          int tile, std::vector<std::uint8_t>& rgb) const {
+namespace {
+
+/// Every tile of the image, in parallel; `body(x0, y0, x1, y1)` gets the tile's pixel range.
+/// Each pixel's random numbers depend on (pixel, sample, dimension) only, so the dynamic tile
+/// order cannot change a byte.
+template <class Body>
+void forEachTile(const CameraRays& camera, const Body& body) {
     const int tilesX = (camera.width + kTileSize - 1) / kTileSize;
-    const int x0 = (tile % tilesX) * kTileSize;
-    const int y0 = (tile / tilesX) * kTileSize;
-    long long rays = 0;
-    for (int y = y0; y < std::min(y0 + kTileSize, camera.height); ++y) {
-        for (int x = x0; x < std::min(x0 + kTileSize, camera.width); ++x) {
-            const std::size_t pixel = std::size_t(y) * camera.width + x;
-            Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-            for (int s = 0; s < spp; ++s) {
-                Sampler rng(pixel, std::uint32_t(s), std::uint32_t(spp));
-                const auto [jx, jy] = rng.next2D();
-                const Vec3 d = camera.direction(x, y, jx, jy);
-                sum += tracer.radiance(camera.origin, d, rng, rays).cast<double>();
-            }
-            for (int k = 0; k < 3; ++k) rgb[pixel * 3 + k] = displayByte(sum[k] / spp, tracer.tone);
-        }
+    const int tiles = tilesX * ((camera.height + kTileSize - 1) / kTileSize);
+#pragma omp parallel for schedule(dynamic)
+    for (int tile = 0; tile < tiles; ++tile) {
+        const int x0 = (tile % tilesX) * kTileSize, y0 = (tile / tilesX) * kTileSize;
+        body(x0, y0, std::min(x0 + kTileSize, camera.width),
+             std::min(y0 + kTileSize, camera.height));
     }
-    return rays;
 }
 
-Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera, int spp) {
-    Image image{camera.width, camera.height,
-                std::vector<std::uint8_t>(std::size_t(camera.width) * camera.height * 3)};
-    const int tiles = ((camera.width + kTileSize - 1) / kTileSize) *
-                      ((camera.height + kTileSize - 1) / kTileSize);
-    long long total = 0;
-    // Each pixel's random numbers depend on (pixel, sample, dimension) only, so the dynamic
-    // tile order cannot change a byte, and the integer ray count sums exactly.
-#pragma omp parallel for schedule(dynamic) reduction(+ : total)
-    for (int tile = 0; tile < tiles; ++tile)
-        total += traceTile(tracer, camera, spp, tile, image.rgb);
-    rays = total;
+}  // namespace
+
+/// The mean of pixel (x, y)'s spp samples, linear; adds the rays they traced to `rays`.
+Vec3 EmbreeRenderer::Impl::samplePixel(const Tracer& tracer, const CameraRays& camera, int spp,
+                                       int x, int y, long long& rays) const {
+    const std::size_t pixel = std::size_t(y) * camera.width + x;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int s = 0; s < spp; ++s) {
+        Sampler rng(pixel ^ tracer.seedKey, std::uint32_t(s), std::uint32_t(spp));
+        const auto [jx, jy] = rng.next2D();
+        sum += tracer.radiance(camera.origin, camera.direction(x, y, jx, jy), rng, rays)
+                   .cast<double>();
+    }
+    return (sum / spp).cast<float>();
+}
+
+Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera, int spp,
+                                  FrameLayers* layers) {
+    const std::size_t pixels = std::size_t(camera.width) * camera.height;
+    std::vector<float> linear(pixels * 3);
+    if (layers) {
+        *layers = FrameLayers{camera.width, camera.height, {}, {}, {}, {}};
+        layers->depth.resize(pixels);
+        layers->normal.resize(pixels * 3);
+        if (tracer.hasTheta()) layers->theta.resize(pixels);
+    }
+    // Counted per pixel, so the total is the same integer sum in any tile order.
+    std::vector<long long> pixelRays(pixels, 0);
+    forEachTile(camera, [&](int x0, int y0, int x1, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t pixel = std::size_t(y) * camera.width + x;
+                const Vec3 c = samplePixel(tracer, camera, spp, x, y, pixelRays[pixel]);
+                for (int k = 0; k < 3; ++k) linear[pixel * 3 + k] = c[k];
+                if (layers) firstHitLayers(tracer, camera, x, y, pixel, *layers, pixelRays[pixel]);
+            }
+        }
+    });
+    rays = 0;
+    for (long long r : pixelRays) rays += r;
+    Image image{camera.width, camera.height, std::vector<std::uint8_t>(pixels * 3)};
+    for (std::size_t i = 0; i < pixels * 3; ++i) image.rgb[i] = displayByte(linear[i], tracer.tone);
+    if (layers) layers->rgb = std::move(linear);
     return image;
 }
 
@@ -864,22 +948,17 @@ EmbreeRenderer::EmbreeRenderer() : impl_(std::make_unique<Impl>()) {
 
 EmbreeRenderer::~EmbreeRenderer() = default;
 
-Image EmbreeRenderer::render(const Geometry& geometry, const RenderSettings& settings) {
+Image EmbreeRenderer::render(const Geometry& geometry, const RenderSettings& settings,
+                             FrameLayers* layers) {
     if (settings.width <= 0 || settings.height <= 0)
         throw std::invalid_argument("EmbreeRenderer: image size must be positive");
     std::visit([](const auto& g) { checkGeometry(g); }, geometry);
     impl_->upload(geometry);
     Tracer tracer = makeTracer(geometry, settings);
     tracer.scene = impl_->scene;
-    CameraRays camera;
-    camera.origin = toFloat(settings.camera.position);
-    camera.basis =
-        detail::viewBasis(settings.camera.position, settings.camera.lookAt, settings.camera.up);
-    camera.fovY = settings.camera.fovYDegrees;
-    camera.aspect = double(settings.width) / settings.height;
-    camera.width = settings.width;
-    camera.height = settings.height;
-    return impl_->trace(tracer, camera, std::max(1, settings.pathTracing.samplesPerPixel));
+    const CameraRays camera(settings);
+    const int spp = std::max(1, settings.pathTracing.samplesPerPixel);
+    return impl_->trace(tracer, camera, spp, layers);
 }
 
 std::string EmbreeRenderer::deviceDescription() {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "render/ExrWriter.h"
 #include "render/Geometry.h"
 #include "render/Image.h"
 #include "render/RenderSettings.h"
@@ -24,8 +25,11 @@ public:
 
     /// Renders one frame. A frame with the same topology as the previous call (same geometry
     /// kind, same triangle indices or disc count) only refits the BVH. Throws
-    /// std::invalid_argument for inconsistent geometry or a non-positive image size.
-    Image render(const Geometry& geometry, const RenderSettings& settings);
+    /// std::invalid_argument for inconsistent geometry or a non-positive image size. With
+    /// `layers`, also fills its linear radiance and the first-hit depth, normal and theta of
+    /// each pixel's centre ray (for writeExrAtomic).
+    Image render(const Geometry& geometry, const RenderSettings& settings,
+                 FrameLayers* layers = nullptr);
 
     /// The Embree version actually loaded, e.g. "Embree 3.13.5".
     std::string deviceDescription();

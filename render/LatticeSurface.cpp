@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include "render/ColorMap.h"
 #include "render/RestTopology.h"
@@ -108,6 +109,7 @@ void addWalls(Mesh& mesh, std::uint32_t sheetVertices,
             mesh.normals.push_back(normals[v]);
             mesh.colors.push_back(mesh.colors[v]);
             if (!mesh.layers.empty()) mesh.layers.push_back(mesh.layers[v]);
+            if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
         }
         return wall[v];
     };
@@ -133,6 +135,7 @@ void extrude(Mesh& mesh, double thickness) {
         mesh.normals.push_back(-mesh.normals[v]);
         mesh.colors.push_back(mesh.colors[v]);
         if (!mesh.layers.empty()) mesh.layers.push_back(mesh.layers[v]);
+        if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
     }
     const std::size_t faces = mesh.triangles.size();
     for (std::size_t t = 0; t < faces; ++t) {
@@ -408,10 +411,12 @@ public:
         : s_(surface), cuts_(cuts), corners_(corners), placed_(placed), mesh_(mesh) {
         colours_ = particleColors(frame, settings);
         layers_ = particleLayers(frame, settings);
+        theta_ = frame.theta;
         const std::size_t vertices = placed.size() + corners.copyOf.size() + 2 * cuts.edges.size();
         mesh.positions.reserve(vertices);
         mesh.colors.reserve(vertices);
         mesh.layers.reserve(layers_.empty() ? 0 : vertices);
+        mesh.theta.reserve(theta_.empty() ? 0 : vertices);
         for (int i = 0; i < static_cast<int>(placed.size()); ++i) add(x(i), attributes(i));
         for (int p : corners.copyOf) add(x(p), attributes(p));
         lipBase_ = static_cast<std::uint32_t>(mesh.positions.size());
@@ -471,21 +476,25 @@ private:
     struct Attributes {
         Eigen::Vector3f colour;
         Eigen::Vector2f layer = Eigen::Vector2f::Zero();
+        float theta = 0.0f;
     };
 
     Attributes attributes(int i) const {
-        return {colours_[i], layers_.empty() ? Eigen::Vector2f::Zero() : layers_[i]};
+        return {colours_[i], layers_.empty() ? Eigen::Vector2f::Zero() : layers_[i],
+                theta_.empty() ? 0.0f : float(theta_[i])};
     }
 
     /// Interpolated at fraction t of the way from particle i to j.
     Attributes attributes(int i, int j, float t) const {
         const Attributes a = attributes(i), b = attributes(j);
-        return {(1.0f - t) * a.colour + t * b.colour, (1.0f - t) * a.layer + t * b.layer};
+        return {(1.0f - t) * a.colour + t * b.colour, (1.0f - t) * a.layer + t * b.layer,
+                (1.0f - t) * a.theta + t * b.theta};
     }
 
     Attributes meanAttributes(const std::array<int, 3>& c) const {
         const Attributes a = attributes(c[0]), b = attributes(c[1]), d = attributes(c[2]);
-        return {(a.colour + b.colour + d.colour) / 3.0f, (a.layer + b.layer + d.layer) / 3.0f};
+        return {(a.colour + b.colour + d.colour) / 3.0f, (a.layer + b.layer + d.layer) / 3.0f,
+                (a.theta + b.theta + d.theta) / 3.0f};
     }
 
     Eigen::Vector3d x(int v) const { return placed_.x(v); }
@@ -498,6 +507,7 @@ private:
         mesh_.positions.push_back(position.cast<float>());
         mesh_.colors.push_back(attributes.colour);
         if (!layers_.empty()) mesh_.layers.push_back(attributes.layer);
+        if (!theta_.empty()) mesh_.theta.push_back(attributes.theta);
         return static_cast<std::uint32_t>(mesh_.positions.size() - 1);
     }
 
@@ -614,6 +624,7 @@ private:
     const Placed& placed_;
     std::vector<Eigen::Vector3f> colours_;
     std::vector<Eigen::Vector2f> layers_;  ///< empty where a colour map replaces the look
+    std::span<const double> theta_;        ///< the frame's; empty without diffusion (EXR layer)
     Mesh& mesh_;
     std::uint32_t lipBase_ = 0;
     static constexpr int kNotFitted = -1, kNoFit = -2;

@@ -17,6 +17,7 @@ struct Mesh {
     /// Per vertex, the look's layer inputs (theta over color_range, damage), each in [0, 1]
     /// (ColorMap.h particleLayers); empty where a colour map replaces the look.
     std::vector<Eigen::Vector2f> layers;
+    std::vector<float> theta;  ///< per vertex, the diffusing quantity; empty when there is none
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 
@@ -28,7 +29,8 @@ inline void checkMesh(const Mesh& mesh, std::string_view who) {
         throw std::invalid_argument(std::string(who) + ": " + what);
     };
     if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n) ||
-        (!mesh.layers.empty() && mesh.layers.size() != n))
+        (!mesh.layers.empty() && mesh.layers.size() != n) ||
+        (!mesh.theta.empty() && mesh.theta.size() != n))
         fail("mesh attribute arrays differ in length");
     for (const auto& t : mesh.triangles)
         for (std::uint32_t v : t)

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <optional>
 
 namespace rend::render {
@@ -61,6 +62,9 @@ struct PathTracing {
     Eigen::Vector3d skyZenith{0.35, 0.50, 0.80};
     Eigen::Vector3d skyHorizon{0.85, 0.88, 0.92};
     double sunAngularRadiusDegrees = 2.0;  ///< soft shadows
+    /// Picks another set of random numbers (0: the default). A reference image rendered with
+    /// another seed has noise independent of the images it judges (scripts/bench_cycles.sh).
+    std::uint32_t seed = 0;
 };
 
 /// OpenVDB level set of the particles (ParticlesToLevelSet -> volumeToMesh).

@@ -216,6 +216,7 @@ std::vector<Variation> variations() {
         {"render.vdb_smoothing", {"render.vdb_smoothing=3"}, vdb},
         {"render.vdb_adaptivity", {"render.vdb_adaptivity=0.5"}, vdb},
         {"output.stats", {"output.stats=false"}},
+        {"output.exr", {"output.exr=true"}, embree},
         {"output.export", {"output.export=[\"ply\"]"}},
     };
 }

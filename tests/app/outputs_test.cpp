@@ -34,7 +34,7 @@ void writeManifest(const fs::path& dir, const std::vector<std::string>& files) {
 TEST(RunOutputNames, OnlyTheNamesRendWritesAreAccepted) {
     for (const char* name :
          {"stats.csv", "frames/frame_0001.png", "frames/frame_12345.png", "meshes/frame_0002.obj",
-          "meshes/frame_0002.mtl", "vdb/frame_0003.vdb"})
+          "meshes/frame_0002.mtl", "vdb/frame_0003.vdb", "frames/frame_0004.exr"})
         EXPECT_TRUE(isRunOutputName(name)) << name;
     for (const char* name :
          {"run.json", "../stats.csv", "/etc/passwd", "frames/../stats.csv", "frames/x.png",

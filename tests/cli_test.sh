@@ -235,7 +235,8 @@ check "a hostile run.json" run 0 run "${rerun[@]}" --frames 3-4
 check "a hostile run.json removes nothing outside rend's names" test -e "$tmp/outside.txt" -a -e /etc/hostname
 
 # kill -9 mid-run: run.json says the run did not finish.
-"$rend" run scenes/stretch.toml --set time.duration=2 --renderer none --out "$tmp/rerun" >/dev/null 2>&1 &
+# A fixed small step (Table 1's) keeps it running long enough to be killed mid-run.
+"$rend" run scenes/stretch.toml --set time.duration=20 --set time.dt=1e-4 --renderer none --out "$tmp/rerun" >/dev/null 2>&1 &
 killed=$!
 for _ in $(seq 50); do [[ -e "$tmp/rerun/stats.csv.partial" ]] && break; sleep 0.1; done
 sleep 0.5

@@ -556,6 +556,7 @@ void readLook(const TableReader& t, render::RenderSettings& r) {
 void readPathTracing(const TableReader& t, render::PathTracing& p) {
     p.samplesPerPixel = int(t.integer("spp").value_or(p.samplesPerPixel));
     p.maxDepth = int(t.integer("max_depth").value_or(p.maxDepth));
+    p.denoise = t.boolean("denoise").value_or(p.denoise);
     p.material = render::MaterialKind(t.choice("material").value_or(std::size_t(p.material)));
     p.roughness = t.number("roughness").value_or(p.roughness);
     p.transmission = t.number("transmission").value_or(p.transmission);

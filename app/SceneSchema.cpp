@@ -383,6 +383,13 @@ constexpr Param kRender[] = {
     {"spp", T::Integer, closed(1, 4096), "16", "path-traced samples per pixel (embree)", "16"},
     {"max_depth", T::Integer, closed(1, 64), "4", "the longest light path in bounces (embree)",
      "4"},
+    {"denoise",
+     T::Boolean,
+     {},
+     "false",
+     "filter the path-traced noise, keeping edges by each pixel's normal, depth and colour "
+     "(embree; few samples then look like many)",
+     "true"},
     {"material",
      T::Choice,
      {},

@@ -5,7 +5,8 @@
 //       simulates SCENE to FRAME once, exports its lattice mesh (OUT_DIR/meshes/frame_N.ply and
 //       a run.json for scripts/blender_import.py), then renders it at each SPP into
 //       OUT_DIR/rend_SPP.exr and prints "rend spp=S seconds=T" (the best of a few renders when
-//       they are short); ref=SPP renders the reference with another seed. T counts everything from
+//       they are short); ref=SPP renders the reference with another seed; dn=SPP renders with
+//       the denoiser on into OUT_DIR/rend_dnSPP.exr. T counts everything from
 //       handing the mesh to a new renderer (device, BVH build) to the linear image; not the
 //       simulation, the PNG or the EXR.
 //   bench_noise rmse REFERENCE.exr IMAGE.exr...
@@ -93,9 +94,11 @@ int renderCommand(int argc, char** argv) {
         // "ref=N": the reference, with another seed, so that its noise is independent of the
         // measured images' (the same seed would share their first samples).
         const bool reference = std::string(argv[k]).rfind("ref=", 0) == 0;
-        const int spp = std::atoi(argv[k] + (reference ? 4 : 0));
+        const bool denoised = std::string(argv[k]).rfind("dn=", 0) == 0;
+        const int spp = std::atoi(argv[k] + (reference ? 4 : denoised ? 3 : 0));
         rend::render::RenderSettings settings = scene.render;
         settings.pathTracing.seed = reference ? 1 : 0;
+        settings.pathTracing.denoise = denoised;
         rend::render::FrameLayers layers;
         rend::render::Image image;
         Timing best = timeRender(mesh, settings, spp, image, layers);
@@ -104,10 +107,11 @@ int renderCommand(int argc, char** argv) {
             const Timing t = timeRender(mesh, settings, spp, image, layers);
             best = {std::min(best.wall, t.wall), std::min(best.cpu, t.cpu)};
         }
-        const std::string stem = "rend_" + std::to_string(spp);
+        const std::string stem = (denoised ? "rend_dn" : "rend_") + std::to_string(spp);
         rend::render::writeExrAtomic(layers, out / (stem + ".exr"));
         rend::render::writePngAtomic(image, out / (stem + ".png"));
-        std::printf("rend spp=%d seconds=%.4f cpu=%.4f\n", spp, best.wall, best.cpu);
+        std::printf("rend%s spp=%d seconds=%.4f cpu=%.4f\n", denoised ? "_denoised" : "", spp,
+                    best.wall, best.cpu);
         std::fflush(stdout);
     }
     return 0;

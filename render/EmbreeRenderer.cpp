@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "render/Denoise.h"
 #include "render/GlMath.h"
 #include "render/Look.h"
 #include "render/ToneMap.h"
@@ -699,20 +700,42 @@ struct CameraRays {
     }
 };
 
-/// The EXR's first-hit layers of pixel (x, y), from one ray through its centre: depth and normal
-/// are not averaged over the pixel's samples, which would invent surfaces between two depths at
-/// a silhouette.
-void firstHitLayers(const Tracer& tracer, const CameraRays& camera, int x, int y, std::size_t pixel,
-                    FrameLayers& layers, long long& rays) {
-    SurfaceHit hit;
+/// The first hit of pixel (x, y)'s centre ray, for the EXR's layers and the denoiser's guides:
+/// one ray, not an average over the pixel's samples, which would invent surfaces between two
+/// depths at a silhouette.
+bool centreHit(const Tracer& tracer, const CameraRays& camera, int x, int y, SurfaceHit& hit,
+               long long& rays) {
     const Vec3 d = camera.direction(x, y, 0.5f, 0.5f);
-    if (!tracer.intersect(camera.origin, d, RTC_INVALID_GEOMETRY_ID, hit, rays)) {
+    return tracer.intersect(camera.origin, d, RTC_INVALID_GEOMETRY_ID, hit, rays);
+}
+
+void storeLayers(const SurfaceHit* hit, std::size_t pixel, FrameLayers& layers) {
+    if (!hit) {
         layers.depth[pixel] = FrameLayers::kNoHit;
         return;
     }
-    layers.depth[pixel] = hit.t;
-    for (int k = 0; k < 3; ++k) layers.normal[pixel * 3 + k] = hit.shadingNormal[k];
-    if (!layers.theta.empty()) layers.theta[pixel] = hit.ground ? 0.0f : hit.theta;
+    layers.depth[pixel] = hit->t;
+    for (int k = 0; k < 3; ++k) layers.normal[pixel * 3 + k] = hit->shadingNormal[k];
+    if (!layers.theta.empty()) layers.theta[pixel] = hit->ground ? 0.0f : hit->theta;
+}
+
+void storeGuides(const SurfaceHit* hit, std::size_t pixel, float variance, DenoiseGuides& g) {
+    g.variance[pixel] = variance;
+    g.depth[pixel] = hit ? hit->t : FrameLayers::kNoHit;
+    for (int k = 0; k < 3; ++k) {
+        g.albedo[pixel * 3 + k] = hit ? hit->albedo[k] : 1.0f;
+        g.normal[pixel * 3 + k] = hit ? hit->shadingNormal[k] : 0.0f;
+    }
+}
+
+DenoiseGuides emptyGuides(const CameraRays& camera) {
+    const std::size_t pixels = std::size_t(camera.width) * camera.height;
+    return {camera.width,
+            camera.height,
+            std::vector<float>(pixels * 3),
+            std::vector<float>(pixels * 3),
+            std::vector<float>(pixels),
+            std::vector<float>(pixels)};
 }
 
 }  // namespace
@@ -742,9 +765,10 @@ struct EmbreeRenderer::Impl {
     void createSplats(const Splats& splats);
     void copyVertices(const Geometry& geometry);
     void refit();
-    Image trace(const Tracer& tracer, const CameraRays& camera, int spp, FrameLayers* layers);
+    Image trace(const Tracer& tracer, const CameraRays& camera, int spp, bool denoised,
+                FrameLayers* layers);
     Vec3 samplePixel(const Tracer& tracer, const CameraRays& camera, int spp, int x, int y,
-                     long long& rays) const;
+                     long long& rays, float& variance) const;
 };
 
 EmbreeRenderer::Impl::~Impl() {
@@ -883,22 +907,31 @@ void forEachTile(const CameraRays& camera, const Body& body) {
 
 }  // namespace
 
-/// The mean of pixel (x, y)'s spp samples, linear; adds the rays they traced to `rays`.
+/// The mean of pixel (x, y)'s spp samples, linear, and the variance of that mean's luminance
+/// from the samples' spread (0 for one sample); adds the rays traced to `rays`.
 Vec3 EmbreeRenderer::Impl::samplePixel(const Tracer& tracer, const CameraRays& camera, int spp,
-                                       int x, int y, long long& rays) const {
+                                       int x, int y, long long& rays, float& variance) const {
     const std::size_t pixel = std::size_t(y) * camera.width + x;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double sumSquares = 0.0;
     for (int s = 0; s < spp; ++s) {
         Sampler rng(pixel ^ tracer.seedKey, std::uint32_t(s), std::uint32_t(spp));
         const auto [jx, jy] = rng.next2D();
-        sum += tracer.radiance(camera.origin, camera.direction(x, y, jx, jy), rng, rays)
-                   .cast<double>();
+        const Eigen::Vector3d c =
+            tracer.radiance(camera.origin, camera.direction(x, y, jx, jy), rng, rays)
+                .cast<double>();
+        sum += c;
+        const double l = 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
+        sumSquares += l * l;
     }
-    return (sum / spp).cast<float>();
+    const Eigen::Vector3d mean = sum / spp;
+    const double l = 0.2126 * mean.x() + 0.7152 * mean.y() + 0.0722 * mean.z();
+    variance = spp > 1 ? float(std::max(0.0, sumSquares / spp - l * l) / (spp - 1)) : 0.0f;
+    return mean.cast<float>();
 }
 
 Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera, int spp,
-                                  FrameLayers* layers) {
+                                  bool denoised, FrameLayers* layers) {
     const std::size_t pixels = std::size_t(camera.width) * camera.height;
     std::vector<float> linear(pixels * 3);
     if (layers) {
@@ -907,20 +940,28 @@ Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera
         layers->normal.resize(pixels * 3);
         if (tracer.hasTheta()) layers->theta.resize(pixels);
     }
+    DenoiseGuides guides = denoised ? emptyGuides(camera) : DenoiseGuides{};
     // Counted per pixel, so the total is the same integer sum in any tile order.
     std::vector<long long> pixelRays(pixels, 0);
     forEachTile(camera, [&](int x0, int y0, int x1, int y1) {
         for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; ++x) {
                 const std::size_t pixel = std::size_t(y) * camera.width + x;
-                const Vec3 c = samplePixel(tracer, camera, spp, x, y, pixelRays[pixel]);
+                float variance = 0.0f;
+                const Vec3 c = samplePixel(tracer, camera, spp, x, y, pixelRays[pixel], variance);
                 for (int k = 0; k < 3; ++k) linear[pixel * 3 + k] = c[k];
-                if (layers) firstHitLayers(tracer, camera, x, y, pixel, *layers, pixelRays[pixel]);
+                if (!layers && !denoised) continue;
+                SurfaceHit hit;
+                const bool found = centreHit(tracer, camera, x, y, hit, pixelRays[pixel]);
+                if (layers) storeLayers(found ? &hit : nullptr, pixel, *layers);
+                if (denoised) storeGuides(found ? &hit : nullptr, pixel, variance, guides);
             }
         }
     });
     rays = 0;
     for (long long r : pixelRays) rays += r;
+    if (denoised && spp == 1) guides.variance.clear();  // no spread from one sample
+    if (denoised) denoise(linear, guides);
     Image image{camera.width, camera.height, std::vector<std::uint8_t>(pixels * 3)};
     for (std::size_t i = 0; i < pixels * 3; ++i) image.rgb[i] = displayByte(linear[i], tracer.tone);
     if (layers) layers->rgb = std::move(linear);
@@ -958,7 +999,7 @@ Image EmbreeRenderer::render(const Geometry& geometry, const RenderSettings& set
     tracer.scene = impl_->scene;
     const CameraRays camera(settings);
     const int spp = std::max(1, settings.pathTracing.samplesPerPixel);
-    return impl_->trace(tracer, camera, spp, layers);
+    return impl_->trace(tracer, camera, spp, settings.pathTracing.denoise, layers);
 }
 
 std::string EmbreeRenderer::deviceDescription() {

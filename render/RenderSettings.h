@@ -65,6 +65,9 @@ struct PathTracing {
     /// Picks another set of random numbers (0: the default). A reference image rendered with
     /// another seed has noise independent of the images it judges (scripts/bench_cycles.sh).
     std::uint32_t seed = 0;
+    /// Filter the frame's noise (render/Denoise.h), guided by each pixel's first hit: few
+    /// samples then look like many. Off for measuring noise (scripts/bench_cycles.sh).
+    bool denoise = false;
 };
 
 /// OpenVDB level set of the particles (ParticlesToLevelSet -> volumeToMesh).

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# A whole animation at final quality (>= 250,000 particles), 1920x1080, path traced, and its
-# wall time by stage (from run.json) and particle count.
+# A whole animation at final quality (>= 250,000 particles), 1920x1080, path traced at 2 samples
+# a pixel and denoised (as scripts/demo.sh --final), and its wall time by stage (from run.json)
+# and particle count.
 #   scripts/bench_final.sh [SCENE] [extra rend run options, e.g. --set time.dt=auto]
 #   REND=path/to/rend  OUT=folder  (defaults: build/rend, a temporary folder)
 set -euo pipefail
@@ -11,7 +12,8 @@ rend=${REND:-build/rend}
 out=${OUT:-$(mktemp -d)}
 start=$(date +%s.%N)
 "$rend" run "$scene" --out "$out" --quality final --renderer embree \
-    --set render.width=1920 --set render.height=1080 "$@" >/dev/null
+    --set render.width=1920 --set render.height=1080 --spp 2 --set render.denoise=true "$@" \
+    >/dev/null
 end=$(date +%s.%N)
 python3 - "$out/run.json" "$scene" "$start" "$end" <<'PY'
 import json, sys

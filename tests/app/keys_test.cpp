@@ -198,6 +198,7 @@ std::vector<Variation> variations() {
         {"render.ground_height", {"render.ground_height=0.05"}},
         {"render.spp", {"render.spp=3"}, embree},
         {"render.max_depth", {"render.max_depth=1"}, embree},
+        {"render.denoise", {"render.denoise=true"}, embree},
         {"render.material", {"render.material=conductor"}, embree},
         {"render.roughness",
          {"render.roughness=0.1"},

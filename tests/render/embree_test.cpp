@@ -219,6 +219,25 @@ TEST(EmbreeRenderer, ConductorReadsAsMetalNotAsDiffuse) {
     EXPECT_GT(maxLuma(metal), maxLuma(diffuse) + 10.0);  // sun highlights on the crinkles
 }
 
+TEST(EmbreeRenderer, DenoisedFourSamplesAreCloserToTheReferenceThanSixteen) {
+    // The translucent sheet over the ground: noise in the sheet and in its shadow.
+    RenderSettings settings = smallSettings(MaterialKind::Translucent);
+    settings.pathTracing.transmission = 0.3;
+    settings.pathTracing.seed = 1;
+    settings.pathTracing.samplesPerPixel = 256;
+    const Image reference = renderOnce(wavyMesh(), settings);
+    settings.pathTracing.seed = 0;
+    settings.pathTracing.samplesPerPixel = 16;
+    const Image sixteen = renderOnce(wavyMesh(), settings);
+    settings.pathTracing.samplesPerPixel = 4;
+    const Image four = renderOnce(wavyMesh(), settings);
+    settings.pathTracing.denoise = true;
+    const Image denoised = withThreads(1, [&] { return renderOnce(wavyMesh(), settings); });
+    EXPECT_LT(meanAbsDifference(denoised, reference), meanAbsDifference(sixteen, reference));
+    EXPECT_LT(meanAbsDifference(denoised, reference), 0.5 * meanAbsDifference(four, reference));
+    EXPECT_EQ(withThreads(2, [&] { return renderOnce(wavyMesh(), settings); }).rgb, denoised.rgb);
+}
+
 TEST(EmbreeRenderer, RejectsInconsistentGeometry) {
     EmbreeRenderer renderer;
     Mesh mesh = wavyMesh();

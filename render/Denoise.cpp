@@ -77,8 +77,10 @@ float depthSlope(const Image& im, int x, int y, int dx, int dy) {
 
 /// The light a pixel receives: its radiance over the first hit's albedo (so the surface's own
 /// texture is not blurred), with the variance of its luminance, and the geometry.
-Image demodulate(const std::vector<float>& rgb, const DenoiseGuides& g) {
-    Image im{g.width, g.height, std::vector<Texel>(rgb.size() / 3)};
+void demodulate(const std::vector<float>& rgb, const DenoiseGuides& g, Image& im) {
+    im.width = g.width;
+    im.height = g.height;
+    im.texels.resize(rgb.size() / 3);
     for (std::size_t p = 0; p < im.texels.size(); ++p) {
         Texel& t = im.texels[p];
         std::array<float, 3> a;
@@ -95,7 +97,6 @@ Image demodulate(const std::vector<float>& rgb, const DenoiseGuides& g) {
     for (int y = 0; y < im.height; ++y)
         for (int x = 0; x < im.width; ++x)
             im.at(x, y).slope = {depthSlope(im, x, y, 1, 0), depthSlope(im, x, y, 0, 1)};
-    return im;
 }
 
 void remodulate(const Image& im, const DenoiseGuides& g, std::vector<float>& rgb) {
@@ -118,8 +119,8 @@ float geometryWeight(const Texel& p, const Texel& q, int ox, int oy, float& dept
 }
 
 /// SVGF's 3 x 3 Gaussian of the variance: one pixel's estimate from few samples is noisy.
-std::vector<float> blurredVariance(const Image& im) {
-    std::vector<float> out(im.texels.size());
+void blurredVariance(const Image& im, std::vector<float>& out) {
+    out.resize(im.texels.size());
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < im.height; ++y) {
         for (int x = 0; x < im.width; ++x) {
@@ -134,7 +135,6 @@ std::vector<float> blurredVariance(const Image& im) {
             out[std::size_t(y) * im.width + x] = sum / weight;
         }
     }
-    return out;
 }
 
 /// Pixel (x, y) after one a-trous pass with taps `step` pixels apart: its light, luminance and
@@ -169,8 +169,8 @@ void filterTexel(const Image& im, int x, int y, int step, float sigma2, Texel& o
     out.variance = sumVariance / (weight * weight);
 }
 
-void atrousPass(Image& im, Image& scratch, int step) {
-    const std::vector<float> sigma2 = blurredVariance(im);
+void atrousPass(Image& im, Image& scratch, std::vector<float>& sigma2, int step) {
+    blurredVariance(im, sigma2);
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < im.height; ++y)
         for (int x = 0; x < im.width; ++x)
@@ -180,8 +180,8 @@ void atrousPass(Image& im, Image& scratch, int step) {
 
 /// With one sample a pixel has no spread of its own: the spread of the light's luminance over
 /// its 3 x 3 neighbours on the same side of a silhouette stands in (SVGF's spatial estimate).
-void estimateVariance(Image& im) {
-    std::vector<float> out(im.texels.size());
+void estimateVariance(Image& im, std::vector<float>& out) {
+    out.resize(im.texels.size());
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < im.height; ++y) {
         for (int x = 0; x < im.width; ++x) {
@@ -214,14 +214,28 @@ void checkSizes(const std::vector<float>& rgb, const DenoiseGuides& g) {
 
 }  // namespace
 
-void denoise(std::vector<float>& rgb, const DenoiseGuides& guides, int passes) {
+struct Denoiser::Workspace {
+    Image image, scratch;
+    std::vector<float> variance;
+};
+
+Denoiser::Denoiser() : workspace_(std::make_unique<Workspace>()) {}
+Denoiser::~Denoiser() = default;
+
+void Denoiser::operator()(std::vector<float>& rgb, const DenoiseGuides& guides, int passes) {
     checkSizes(rgb, guides);
     if (rgb.empty()) return;
-    Image image = demodulate(rgb, guides);
-    if (guides.variance.empty()) estimateVariance(image);
-    Image scratch = image;
-    for (int i = 0; i < passes; ++i) atrousPass(image, scratch, 1 << i);
-    remodulate(image, guides, rgb);
+    Workspace& w = *workspace_;
+    demodulate(rgb, guides, w.image);
+    if (guides.variance.empty()) estimateVariance(w.image, w.variance);
+    w.scratch = w.image;
+    for (int i = 0; i < passes; ++i) atrousPass(w.image, w.scratch, w.variance, 1 << i);
+    remodulate(w.image, guides, rgb);
+}
+
+void denoise(std::vector<float>& rgb, const DenoiseGuides& guides, int passes) {
+    Denoiser denoiser;
+    denoiser(rgb, guides, passes);
 }
 
 }  // namespace rend::render

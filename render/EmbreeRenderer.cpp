@@ -728,14 +728,15 @@ void storeGuides(const SurfaceHit* hit, std::size_t pixel, float variance, Denoi
     }
 }
 
-DenoiseGuides emptyGuides(const CameraRays& camera) {
+/// Sizes `g` for the image, keeping its buffers' memory from the frame before.
+void sizeGuides(const CameraRays& camera, DenoiseGuides& g) {
     const std::size_t pixels = std::size_t(camera.width) * camera.height;
-    return {camera.width,
-            camera.height,
-            std::vector<float>(pixels * 3),
-            std::vector<float>(pixels * 3),
-            std::vector<float>(pixels),
-            std::vector<float>(pixels)};
+    g.width = camera.width;
+    g.height = camera.height;
+    g.albedo.resize(pixels * 3);
+    g.normal.resize(pixels * 3);
+    g.depth.resize(pixels);
+    g.variance.resize(pixels);
 }
 
 }  // namespace
@@ -755,6 +756,11 @@ struct EmbreeRenderer::Impl {
     float* normals = nullptr;
     std::string lastError;
     long long rays = 0;
+    // Per-frame buffers, kept so that a 1080p frame does not fault in 100 MB of fresh pages.
+    std::vector<float> linear;
+    std::vector<long long> pixelRays;  ///< counted per pixel: the same sum in any tile order
+    DenoiseGuides guides;
+    Denoiser denoiser;
 
     ~Impl();
     void check(const char* what);
@@ -933,16 +939,15 @@ Vec3 EmbreeRenderer::Impl::samplePixel(const Tracer& tracer, const CameraRays& c
 Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera, int spp,
                                   bool denoised, FrameLayers* layers) {
     const std::size_t pixels = std::size_t(camera.width) * camera.height;
-    std::vector<float> linear(pixels * 3);
+    linear.resize(pixels * 3);
     if (layers) {
         *layers = FrameLayers{camera.width, camera.height, {}, {}, {}, {}};
         layers->depth.resize(pixels);
         layers->normal.resize(pixels * 3);
         if (tracer.hasTheta()) layers->theta.resize(pixels);
     }
-    DenoiseGuides guides = denoised ? emptyGuides(camera) : DenoiseGuides{};
-    // Counted per pixel, so the total is the same integer sum in any tile order.
-    std::vector<long long> pixelRays(pixels, 0);
+    if (denoised) sizeGuides(camera, guides);
+    pixelRays.assign(pixels, 0);
     forEachTile(camera, [&](int x0, int y0, int x1, int y1) {
         for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; ++x) {
@@ -961,10 +966,10 @@ Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera
     rays = 0;
     for (long long r : pixelRays) rays += r;
     if (denoised && spp == 1) guides.variance.clear();  // no spread from one sample
-    if (denoised) denoise(linear, guides);
+    if (denoised) denoiser(linear, guides);
     Image image{camera.width, camera.height, std::vector<std::uint8_t>(pixels * 3)};
     for (std::size_t i = 0; i < pixels * 3; ++i) image.rgb[i] = displayByte(linear[i], tracer.tone);
-    if (layers) layers->rgb = std::move(linear);
+    if (layers) layers->rgb = linear;
     return image;
 }
 

@@ -545,6 +545,14 @@ private:
     /// The deformation of the first intact neighbour that has one: a particle at a corner of
     /// its piece may have a single intact side.
     bool neighbourDeformation(int a, Eigen::Matrix3d& F) {
+        return anyIntactNeighbour(a, [&](int j) { return deformation(j, F); });
+    }
+
+    /// Calls visit(j) for each lattice neighbour j of particle a through an intact side of a
+    /// present triangle (twice where two triangles share the side) until visit returns true;
+    /// returns whether one did.
+    template <class Visit>
+    bool anyIntactNeighbour(int a, Visit&& visit) const {
         for (int k = s_.incidentOffsets_[a]; k < s_.incidentOffsets_[a + 1]; ++k) {
             const int t = s_.incident_[k];
             if (!cuts_.present[t]) continue;
@@ -553,7 +561,7 @@ private:
                 const int e = s_.edges_.ofTriangle[t][side];
                 if (cuts_.broken(e)) continue;
                 const auto& ends = s_.edges_.ends[e];
-                if (deformation(ends[0] == a ? ends[1] : ends[0], F)) return true;
+                if (visit(ends[0] == a ? ends[1] : ends[0])) return true;
             }
         }
         return false;
@@ -580,20 +588,12 @@ private:
 
     bool fitDeformation(int a, Eigen::Matrix3d& F) const {
         Eigen::Matrix3d moved = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
-        for (int k = s_.incidentOffsets_[a]; k < s_.incidentOffsets_[a + 1]; ++k) {
-            const int t = s_.incident_[k];
-            if (!cuts_.present[t]) continue;
-            const int c = s_.cornerOf(t, a);
-            for (int side : {c, (c + 2) % 3}) {
-                const int e = s_.edges_.ofTriangle[t][side];
-                if (cuts_.broken(e)) continue;
-                const int j =
-                    s_.edges_.ends[e][0] == a ? s_.edges_.ends[e][1] : s_.edges_.ends[e][0];
-                const Eigen::Vector3d restOffset = rest(j) - rest(a);
-                moved += (x(j) - x(a)) * restOffset.transpose();
-                spread += restOffset * restOffset.transpose();
-            }
-        }
+        anyIntactNeighbour(a, [&](int j) {
+            const Eigen::Vector3d restOffset = rest(j) - rest(a);
+            moved += (x(j) - x(a)) * restOffset.transpose();
+            spread += restOffset * restOffset.transpose();
+            return false;
+        });
         // The rest normal, scaled like the in-plane spread, makes the spread invertible; it
         // maps nothing, since the offsets F is applied to lie in the plane.
         const double scale = 0.5 * spread.trace();

@@ -277,10 +277,13 @@ constexpr Param kForces[] = {
 constexpr Param kTimeKeys[] = {
     {"dt", T::NumberOrWord, positive(10.0), "\"adaptive\" (see the README's time step)",
      "the time step in seconds (fixed); \"auto\": safety x the stable bound, fixed; "
-     "\"adaptive\": safety x the current bound, cut where bonds stretch fast or break in bursts",
+     "\"adaptive\": min(safety, 0.5) x the current bound, cut where bonds stretch fast or break "
+     "in bursts",
      "3e-4", names::kStepWords},
     {"safety", T::Number, Range::openClosed(0.0, 1.0), "0.8",
-     "the fraction of the stable time step used by dt = \"auto\" and \"adaptive\"", "0.8"},
+     "the fraction of the stable time step used by dt = \"auto\"; \"adaptive\" takes at most "
+     "0.5 of it, lower when set lower",
+     "0.8"},
     {"max_stretch_increment", T::Number, Range::openClosed(0.0, 1.0), "0.02",
      "adaptive dt: the most a bond loaded past half its critical stretch may stretch in one "
      "step, as a fraction of the critical stretch",

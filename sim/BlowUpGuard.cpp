@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "sim/Parallel.h"
+#include "sim/TimeStep.h"
 
 namespace rend::sim {
 namespace {
@@ -69,7 +70,8 @@ BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
     const double waveSpeed = capped(params.sheet.dx * std::sqrt(worstRatio), kLightSpeed);
     const double fall =
         capped(params.gravity.norm(), kLightSpeed) * capped(params.time.duration, kLightSpeed);
-    safety_ = params.time.safety;
+    // Only the adaptive advice reads it: what that step takes, at most half the bound.
+    safety_ = std::min(params.time.safety, TimeStepController::kMostOfBound);
     speedLimit_ = capped(100.0 * waveSpeed + 10.0 * boundarySpeed + 2.0 * fall + 1e-6, kLightSpeed);
 
     gravity_ = params.gravity.allFinite() ? params.gravity : Eigen::Vector3d::Zero();

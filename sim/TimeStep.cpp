@@ -12,7 +12,7 @@ constexpr double kSmallest = 1.0 / 64;
 }  // namespace
 
 TimeStepController::TimeStepController(const TimeParams& time)
-    : safety_(time.safety),
+    : safety_(std::min(time.safety, kMostOfBound)),
       maxIncrement_(time.maxStretchIncrement),
       burstBonds_(double(time.burstBonds)) {}
 

@@ -240,7 +240,12 @@ std::size_t Membrane::breakCount() const {
     return damageState_.brokenBondCount() + damageState_.removedTriangleCount();
 }
 
-double Membrane::currentStableTimeStep() const { return stableDt_ / std::sqrt(stiffening_); }
+// The same guard as a fixed step's sub-steps (piecesOfStep): a bond squashed far past what any
+// sheet shows (a collapsed lattice cell in a crumple) slows the step at most kMaxPieces-fold, or
+// one bond of a million would set the step of the whole sheet.
+double Membrane::currentStableTimeStep() const {
+    return stableDt_ / std::min(std::sqrt(stiffening_), double(kMaxPieces));
+}
 
 // Only loaded bonds count: what a step must resolve is the order in which bonds near a crack
 // tip reach eta_c, not the lattice-scale ringing of unloaded ones (which the bound keeps stable).

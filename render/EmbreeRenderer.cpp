@@ -131,6 +131,13 @@ struct Frame {
     Vec3 toWorld(const Vec3& v) const { return v.x() * t + v.y() * b + v.z() * n; }
 };
 
+/// Veach's power heuristic: the weight of a sample drawn with density `mine` when `other`
+/// could have drawn it too.
+float powerHeuristic(float mine, float other) {
+    const float a = mine * mine, b = other * other;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
 Vec3 sampleCosineHemisphere(float u1, float u2) {
     const float r = std::sqrt(u1);
     const float phi = 2.0f * kPi * u2;
@@ -204,7 +211,12 @@ struct Bsdf {
     Vec3 evalCos(const Vec3& wo, const Vec3& wi) const;
 
     /// Draws wi; `weight` = f |cos| / pdf (each component <= 1). False: the path is absorbed.
-    bool sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight) const;
+    /// `delta`: wi is the film's straight-through direction, which no light sample can draw.
+    bool sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight, bool& delta) const;
+
+    /// The solid-angle density with which sample() draws wi (its non-delta lobes), for
+    /// multiple importance sampling of the sun.
+    float pdf(const Vec3& wo, const Vec3& wi) const;
 
     /// Fraction of light passing straight through (film only; other sheets are opaque to
     /// shadow rays).
@@ -239,7 +251,36 @@ Vec3 Bsdf::evalCos(const Vec3& wo, const Vec3& wi) const {
     return Vec3::Zero();
 }
 
-bool Bsdf::sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight) const {
+/// Density of the visible-normal GGX reflection of wo into wi: D_wo(h) / (4 wo.h) with
+/// D_wo(h) = G1(wo) (wo.h) D(h) / wo.z (Heitz 2018), i.e. G1(wo) D(h) / (4 wo.z).
+float ggxReflectionPdf(const Vec3& wo, const Vec3& wi, float alpha) {
+    if (wi.z() <= 0.0f) return 0.0f;
+    const Vec3 h = (wo + wi).normalized();
+    const float g1 = 1.0f / (1.0f + ggxLambda(wo, alpha));
+    return g1 * ggxD(h, alpha) / (4.0f * wo.z());
+}
+
+float Bsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+    const float cosine = std::abs(wi.z()) / kPi;
+    switch (kind) {
+        case MaterialKind::Diffuse:
+            return wi.z() > 0.0f ? cosine : 0.0f;
+        case MaterialKind::Conductor:
+            return ggxReflectionPdf(wo, wi, alpha);
+        case MaterialKind::Film: {
+            const float fo = schlick(kFilmF0, wo.z());
+            const float diffuse =
+                wi.z() > 0.0f ? (1.0f - fo) * (1.0f - transmission) * cosine : 0.0f;
+            return fo * ggxReflectionPdf(wo, wi, alpha) + diffuse;
+        }
+        case MaterialKind::Translucent:
+            return (wi.z() > 0.0f ? 1.0f - transmission : transmission) * cosine;
+    }
+    return 0.0f;
+}
+
+bool Bsdf::sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight, bool& delta) const {
+    delta = false;
     const float u0 = rng.next1D();
     const auto [u1, u2] = rng.next2D();
     switch (kind) {
@@ -272,6 +313,7 @@ bool Bsdf::sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight) const {
             weight = albedo;
             if ((u0 - fo) / (1.0f - fo) < transmission) {
                 wi = -wo;  // a thin sheet: no refraction offset
+                delta = true;
                 return true;
             }
             wi = sampleCosineHemisphere(u1, u2);
@@ -388,6 +430,13 @@ struct Tracer {
     Frame sunFrame{Vec3::UnitZ()};
 
     bool hasTheta() const { return mesh && !mesh->theta.empty(); }
+
+    /// Solid-angle density of a uniform sample of the sun's cone; 0 for a point sun, which only
+    /// next-event estimation can reach.
+    float sunPdf() const {
+        return sunCosMax < 1.0f ? 1.0f / (2.0f * kPi * (1.0f - sunCosMax)) : 0.0f;
+    }
+    bool inSun(const Vec3& d) const { return sunCosMax < 1.0f && d.dot(sunDirection) >= sunCosMax; }
 
     Vec3 environment(const Vec3& d) const {
         if (!sky) return background;
@@ -539,7 +588,8 @@ Vec3 Tracer::sunLight(const SurfaceHit& hit, const Bsdf& bsdf, const Frame& fram
     const Vec3 f = bsdf.evalCos(wo, wi);
     if (maxComponent(f) <= 0.0f) return Vec3::Zero();
     const Vec3 visible = shadowTransmittance(spawnOrigin(hit, wiWorld), wiWorld, hit.prim, rays);
-    return f.cwiseProduct(visible).cwiseProduct(sunIrradiance);
+    const float weight = sunPdf() > 0.0f ? powerHeuristic(sunPdf(), bsdf.pdf(wo, wi)) : 1.0f;
+    return weight * f.cwiseProduct(visible).cwiseProduct(sunIrradiance);
 }
 
 Vec3 clampContribution(const Vec3& c, int depth) {
@@ -548,8 +598,11 @@ Vec3 clampContribution(const Vec3& c, int depth) {
     return m > kIndirectClamp ? Vec3(c * (kIndirectClamp / m)) : c;
 }
 
-/// Unidirectional path tracing: the sun by next-event estimation at every vertex, the
-/// environment when a path escapes (the sun is not part of it, so nothing is counted twice).
+/// Unidirectional path tracing: the environment when a path escapes, and the sun both by
+/// next-event estimation at every vertex and by the BSDF's own sample when it escapes into the
+/// sun's cone, the two weighted by the power heuristic (Veach 1997, ch. 9). A glossy metal's lobe
+/// is narrower than the sun: its cone samples then rarely land in the lobe, with huge values
+/// (glints that take thousands of samples to settle), while its BSDF samples hit the sun.
 ///
 /// Sky light on the ground plane uses a control variate: the ground's cosine-sampled bounce
 /// would see the sky gradient L(d), whose cosine-weighted mean is known in closed form
@@ -563,11 +616,20 @@ Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays
     Vec3 throughput = Vec3::Ones();
     std::uint32_t fromPrim = RTC_INVALID_GEOMETRY_ID;
     bool skyControl = false;  // the last vertex already added the open sky's mean
+    // The density with which the last scattering vertex drew this direction (0: the camera), and
+    // that vertex's depth: a path that escapes into the sun's cone is the other half of that
+    // vertex's sun sample, weighted against it.
+    float misPdf = 0.0f;
+    int misDepth = 0;
     for (int depth = 0;; ++depth) {
         SurfaceHit hit;
         if (!intersect(origin, direction, fromPrim, hit, rays)) {
             if (!skyControl)
                 result += clampContribution(throughput.cwiseProduct(environment(direction)), depth);
+            if (misPdf > 0.0f && inSun(direction)) {
+                const Vec3 sun = sunIrradiance * (sunPdf() * powerHeuristic(misPdf, sunPdf()));
+                result += clampContribution(throughput.cwiseProduct(sun), misDepth);
+            }
             break;
         }
         if (skyControl) result -= throughput.cwiseProduct(environment(direction));
@@ -586,9 +648,14 @@ Vec3 Tracer::radiance(Vec3 origin, Vec3 direction, Sampler& rng, long long& rays
             skyControl = true;
         }
         Vec3 wi, weight;
-        if (!bsdf.sample(wo, rng, wi, weight)) break;
+        bool delta = false;
+        if (!bsdf.sample(wo, rng, wi, weight, delta)) break;
         direction = frame.toWorld(wi).normalized();
         if ((wi.z() > 0.0f) != (hit.geometricNormal.dot(direction) > 0.0f)) break;
+        if (!delta) {  // straight through a film keeps the direction, and its density
+            misPdf = bsdf.pdf(wo, wi);
+            misDepth = depth;
+        }
         throughput = throughput.cwiseProduct(weight);
         if (depth >= kRouletteDepth) {
             const float survive = std::clamp(maxComponent(throughput), 0.05f, 1.0f);

@@ -13,7 +13,8 @@
 # Counted: rend from handing the mesh to a new renderer (device, BVH build, tracing) to the
 # linear image; Cycles bpy.ops.render.render alone (sync, BVH build, tracing). Neither counts
 # start-up, the simulation, the import or the file writes. Needs Debian's blender; says so and
-# exits 0 without it. Never fails on a time.
+# exits 0 without it. Never fails on a time. CYCLES_FROM=DIR reuses the Cycles renders of a run
+# kept with KEEP_BENCH=1 (the same arguments), to measure a change to rend alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-scenes/foil_tear.toml}; frame=${2:-192}; width=${3:-960}; height=${4:-540}
@@ -30,8 +31,14 @@ blender_run() {
     blender -b --factory-startup -P scripts/blender_import.py -- "$tmp" --frame "$frame" \
         --width "$width" --height "$height" --exr-dir "$tmp" "$@" 2>/dev/null | grep '^cycles '
 }
-blender_run --samples "$(echo $cycles_spp | tr ' ' ',')" > "$tmp/cycles.txt"
-blender_run --samples "$reference" --reference > "$tmp/cycles_ref.txt"
+if [[ -n ${CYCLES_FROM:-} ]]; then
+    # Cycles' renders of an earlier run kept with KEEP_BENCH (same scene, frame, size and spp):
+    # for iterating on rend alone.
+    cp "$CYCLES_FROM"/cycles*.txt "$CYCLES_FROM"/cycles_*.exr "$tmp"/
+else
+    blender_run --samples "$(echo $cycles_spp | tr ' ' ',')" > "$tmp/cycles.txt"
+    blender_run --samples "$reference" --reference > "$tmp/cycles_ref.txt"
+fi
 for r in rend cycles; do
     spps=$rend_spp; [[ $r == cycles ]] && spps=$cycles_spp
     build/bench_noise rmse "$tmp/${r}_$reference.exr" $(for s in $spps; do echo "$tmp/${r}_$s.exr"; done) \

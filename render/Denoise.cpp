@@ -81,7 +81,9 @@ void demodulate(const std::vector<float>& rgb, const DenoiseGuides& g, Image& im
     im.width = g.width;
     im.height = g.height;
     im.texels.resize(rgb.size() / 3);
-    for (std::size_t p = 0; p < im.texels.size(); ++p) {
+    const auto n = std::ptrdiff_t(im.texels.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n; ++p) {
         Texel& t = im.texels[p];
         std::array<float, 3> a;
         for (int k = 0; k < 3; ++k) {
@@ -94,13 +96,16 @@ void demodulate(const std::vector<float>& rgb, const DenoiseGuides& g, Image& im
         t.variance = g.variance.empty() ? 0.0f : g.variance[p] / (l * l);
         t.depth = g.depth[p];
     }
+#pragma omp parallel for schedule(static)
     for (int y = 0; y < im.height; ++y)
         for (int x = 0; x < im.width; ++x)
             im.at(x, y).slope = {depthSlope(im, x, y, 1, 0), depthSlope(im, x, y, 0, 1)};
 }
 
 void remodulate(const Image& im, const DenoiseGuides& g, std::vector<float>& rgb) {
-    for (std::size_t p = 0; p < im.texels.size(); ++p)
+    const auto n = std::ptrdiff_t(im.texels.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n; ++p)
         for (int k = 0; k < 3; ++k)
             rgb[3 * p + k] = im.texels[p].light[k] * std::max(g.albedo[3 * p + k], kMinAlbedo);
 }

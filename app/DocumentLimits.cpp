@@ -218,7 +218,7 @@ private:
         while (pos_ < text_.size()) {
             const char c = text_[pos_];
             if (c == '\\' && quote == '"') {
-                multiLine ? skipMultiLineEscape() : advance(2);
+                skipEscape(multiLine);
             } else if (multiLine && text_.substr(pos_, 3) == triple) {
                 advance(3);
                 // Up to two more quotes belong to the content: """a"""" ends with a quote.
@@ -235,18 +235,25 @@ private:
         }
     }
 
-    /// After a backslash in a """ string toml++ 3.3 tests the next character, or after a
-    /// line-ending backslash the first one that is not whitespace, as whitespace, and reaches
-    /// undefined behaviour for many non-ASCII ones (marzer/tomlplusplus#190, #295).
-    void skipMultiLineEscape() {
+    /// Steps over a backslash in a basic string and what it escapes. Every TOML escape is ASCII,
+    /// and toml++ 3.3 classifies the character after a backslash (or, after a line-ending
+    /// backslash in a """ string, the first one that is not whitespace) in ways that reach
+    /// undefined behaviour for many non-ASCII ones (marzer/tomlplusplus#190, #295), so those
+    /// are refused here. A line-ending backslash escapes only the whitespace after it: what
+    /// follows is content again (another backslash, or the closing quotes), for the caller.
+    void skipEscape(bool multiLine) {
         advance();
-        while (pos_ < text_.size() && isWhitespace(text_[pos_])) advance();
+        bool lineEnding = false;
+        while (multiLine && pos_ < text_.size() && isWhitespace(text_[pos_])) {
+            advance();
+            lineEnding = true;
+        }
         if (pos_ < text_.size() && !isAscii(text_[pos_])) {
             notAscii(
-                "an ASCII character first after a backslash in a \"\"\" string (toml++ 3.3 "
-                "misreads others, marzer/tomlplusplus#190)");
+                "an ASCII character first after a backslash in a string (every escape is "
+                "ASCII; toml++ 3.3 misreads others, marzer/tomlplusplus#190)");
         }
-        advance();
+        if (!lineEnding) advance();
     }
 
     static bool isAscii(char c) { return static_cast<unsigned char>(c) < 0x80; }
@@ -341,6 +348,63 @@ private:
 
 void checkBeforeParsing(std::string_view text, const std::string& source, int baseDepth) {
     PreParseScan(text, source, baseDepth).run();
+}
+
+namespace {
+
+/// Bytes in the UTF-8 sequence that `lead` starts; 0 for a byte no sequence starts with.
+int utf8Length(unsigned char lead) {
+    if (lead < 0x80) return 1;
+    if (lead >= 0xC2 && lead <= 0xDF) return 2;
+    if (lead >= 0xE0 && lead <= 0xEF) return 3;
+    if (lead >= 0xF0 && lead <= 0xF4) return 4;
+    return 0;
+}
+
+/// `text` with each non-ASCII character replaced by '?', so lines and columns (counted in code
+/// points) stay where they were. '?' is valid in strings and comments and nowhere else, so the
+/// stand-in parses only where every non-ASCII character sits in a string or a comment.
+std::string asciiStandIn(std::string_view text, const std::string& source) {
+    std::string standIn;
+    standIn.reserve(text.size());
+    toml::source_position at{1, 1};
+    // toml++ skips a byte order mark and does not count it as a column.
+    const std::size_t start = text.starts_with("\xef\xbb\xbf") ? 3 : 0;
+    standIn.append(text.substr(0, start));
+    for (std::size_t i = start; i < text.size();) {
+        const auto lead = static_cast<unsigned char>(text[i]);
+        const int length = utf8Length(lead);
+        bool valid = length > 0 && i + std::size_t(length) <= text.size();
+        for (int k = 1; valid && k < length; ++k)
+            valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+        if (!valid) {
+            char found[32];
+            std::snprintf(found, sizeof found, "the byte 0x%02X", lead);
+            toml::source_region region{at, at, std::make_shared<const std::string>(source)};
+            throw SceneError(formatError(locationOf(region), "", "text in UTF-8", found,
+                                         "Save the file as UTF-8."));
+        }
+        standIn.push_back(length == 1 ? text[i] : '?');
+        at = lead == '\n' ? toml::source_position{at.line + 1, 1}
+                          : toml::source_position{at.line, at.column + 1};
+        i += std::size_t(length);
+    }
+    return standIn;
+}
+
+}  // namespace
+
+toml::table parseDocument(std::string_view text, const std::string& source, int baseDepth) {
+    checkBeforeParsing(text, source, baseDepth);
+    const bool ascii = std::all_of(text.begin(), text.end(),
+                                   [](char c) { return static_cast<unsigned char>(c) < 0x80; });
+    // toml++ 3.3 reaches undefined behaviour when it classifies some non-ASCII characters
+    // (marzer/tomlplusplus#190, #295), which it does while reading past an error as well as
+    // outside strings. The stand-in has none: where the document is wrong, its error is the
+    // one reported, and the original is parsed only when every non-ASCII character is in a
+    // string or a comment of a well-formed document.
+    if (!ascii) (void)toml::parse(asciiStandIn(text, source), source);
+    return toml::parse(text, source);
 }
 
 }  // namespace rend::scene

@@ -3,6 +3,8 @@
 // parser, so that a hostile input is refused with its location instead of exhausting the stack
 // or the memory.
 
+#include <toml++/toml.h>
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -38,5 +40,12 @@ std::string readDocument(const std::filesystem::path& file, std::string_view wha
 /// preset, merged into [material]); `source` is the path the parser will report, a file or a
 /// --set label. Strings and comments are skipped, so brackets and dots in them do not count.
 void checkBeforeParsing(std::string_view text, const std::string& source, int baseDepth = 0);
+
+/// checkBeforeParsing, then toml::parse. A document with non-ASCII text is parsed first with
+/// each non-ASCII character replaced by '?' (invalid UTF-8 throws SceneError at its location),
+/// and its own parse only when that one succeeds: toml++ 3.3 misreads non-ASCII characters
+/// wherever it is not inside a string or a comment, including while it reads past an error.
+/// Throws toml::parse_error like toml::parse, located in `source`.
+toml::table parseDocument(std::string_view text, const std::string& source, int baseDepth = 0);
 
 }  // namespace rend::scene

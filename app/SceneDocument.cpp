@@ -18,9 +18,8 @@ constexpr std::string_view kSetExample = "KEY=VALUE, e.g. --set material.E=3e4";
 /// Parses TOML text whose nodes will report `sourcePath` as their location, after the checks of
 /// app/DocumentLimits.h (`baseDepth` levels above it).
 toml::table parseText(std::string_view text, std::string sourcePath, int baseDepth = 0) {
-    checkBeforeParsing(text, sourcePath, baseDepth);
     try {
-        return toml::parse(text, std::move(sourcePath));
+        return parseDocument(text, sourcePath, baseDepth);
     } catch (const toml::parse_error& e) {
         throw SceneError(locationOf(e.source()) +
                          ": error: TOML syntax: " + std::string(e.description()));
@@ -46,7 +45,7 @@ std::string overrideLabel(std::string_view override) {
 /// through their shell. Parsing under the --set label gives every node that location.
 toml::table parseOverrideValue(std::string_view value, const std::string& label) {
     try {
-        toml::table parsed = toml::parse("v = " + std::string(value), std::string(label));
+        toml::table parsed = parseDocument("v = " + std::string(value), label);
         if (parsed.size() == 1 && parsed.contains("v")) return parsed;
     } catch (const toml::parse_error&) {
     }

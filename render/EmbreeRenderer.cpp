@@ -51,8 +51,7 @@ std::uint64_t mix64(std::uint64_t z) {
 }
 
 std::uint32_t reverseBits(std::uint32_t x) {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00FF00FFu) << 8) | ((x & 0xFF00FF00u) >> 8);
+    x = __builtin_bswap32(x);
     x = ((x & 0x0F0F0F0Fu) << 4) | ((x & 0xF0F0F0F0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xCCCCCCCCu) >> 2);
     return ((x & 0x55555555u) << 1) | ((x & 0xAAAAAAAAu) >> 1);
@@ -60,41 +59,78 @@ std::uint32_t reverseBits(std::uint32_t x) {
 
 /// Second dimension of the Sobol sequence: its generator matrix is Pascal's triangle mod 2,
 /// whose columns follow v_{k+1} = v_k ^ (v_k >> 1). With the van der Corput first dimension
-/// the pair is a (0, 2)-sequence: every 2^k prefix stratifies the unit square.
+/// the pair is a (0, 2)-sequence: every aligned block of 2^k points stratifies the unit square.
+/// The columns' XOR for each value of each byte of the index is tabulated, so a shuffled index
+/// with high bits set costs four look-ups, not a loop over 32 bits.
+constexpr std::array<std::array<std::uint32_t, 256>, 4> sobolSecondTables() {
+    std::array<std::array<std::uint32_t, 256>, 4> tables{};
+    std::uint32_t column = 1u << 31;
+    for (int byte = 0; byte < 4; ++byte) {
+        std::array<std::uint32_t, 8> columns{};
+        for (std::uint32_t& c : columns) {
+            c = column;
+            column ^= column >> 1;
+        }
+        for (std::uint32_t value = 0; value < 256; ++value)
+            for (int bit = 0; bit < 8; ++bit)
+                if (value & (1u << bit)) tables[byte][value] ^= columns[bit];
+    }
+    return tables;
+}
+
+constexpr auto kSobolSecond = sobolSecondTables();
+
 std::uint32_t sobolSecond(std::uint32_t index) {
-    std::uint32_t result = 0;
-    for (std::uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
-        if (index & 1u) result ^= v;
-    return result;
+    return kSobolSecond[0][index & 0xFFu] ^ kSobolSecond[1][(index >> 8) & 0xFFu] ^
+           kSobolSecond[2][(index >> 16) & 0xFFu] ^ kSobolSecond[3][index >> 24];
+}
+
+/// Laine & Karras's permutation with Burley's constants ("Practical Hash-based Owen Scrambling",
+/// JCGT 2020): bit k of the result depends only on bits 0..k of `x` and on the seed.
+std::uint32_t laineKarras(std::uint32_t x, std::uint32_t seed) {
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+/// A nested uniform (Owen) scramble of a 32-bit fraction: each digit is flipped by a hash of
+/// the digits above it. Keeps every net property of the points it scrambles; applied to a
+/// sample index it shuffles an aligned power-of-two block of indices among themselves.
+std::uint32_t owenScramble(std::uint32_t x, std::uint32_t seed) {
+    return reverseBits(laineKarras(reverseBits(x), seed));
 }
 
 float unitFloat(std::uint32_t bits) { return float(bits >> 8) * 0x1p-24f; }  // [0, 1), never 1
 
 /// Random numbers of one (pixel, sample) path, a pure function of (pixel, sample, dimension):
 /// the n-th request of a path always gets the same value, so a pixel never depends on which
-/// thread renders it, or in which order. 2D requests (camera jitter, sun cone, BSDF lobe
-/// shape) are points of the Sobol (0, 2)-sequence, randomised per pixel and dimension by a
-/// digit XOR (which keeps the stratification) and an index XOR (which shuffles the samples of
-/// different dimensions against each other, and for a power-of-two spp permutes whole nets):
-/// far less noise at 16 spp than independent numbers. 1D requests (lobe choice, roulette) use
-/// the first dimension alone, randomised the same way.
+/// thread renders it, or in which order. Each request (camera jitter, sun cone, lobe choice,
+/// BSDF lobe shape, roulette) is a point of the Sobol (0, 2)-sequence, Owen-scrambled per pixel
+/// and request, whose sample index is itself Owen-scrambled per request (Burley 2020's padded
+/// Sobol). The index shuffle is what makes the requests independent of one another: a digit
+/// XOR on the index would commute with the sequence's linear digits, every request would be a
+/// fixed function of the first, and a pixel would converge to a value of its own instead of
+/// the integral (an error that no sample count removes).
 class Sampler {
 public:
-    Sampler(std::uint64_t pixel, std::uint32_t sample, std::uint32_t samples)
-        : pixelKey_(mix64(pixel)), sample_(sample), indexMask_(std::bit_ceil(samples) - 1) {}
+    Sampler(std::uint64_t pixel, std::uint32_t sample)
+        : pixelKey_(mix64(pixel)), reversedSample_(reverseBits(sample)) {}
 
     float next1D() {
         const std::uint64_t h = dimensionHash();
-        const std::uint32_t index = sample_ ^ (std::uint32_t(h) & indexMask_);
-        return unitFloat(reverseBits(index) ^ std::uint32_t(mix64(h)));
+        // owenScramble(reverseBits(i), s) is reverseBits(laineKarras(i, s)).
+        return unitFloat(reverseBits(laineKarras(shuffledIndex(h), std::uint32_t(h >> 32))));
     }
 
     std::array<float, 2> next2D() {
         const std::uint64_t h = dimensionHash();
-        const std::uint32_t index = sample_ ^ (std::uint32_t(h) & indexMask_);
+        const std::uint32_t index = shuffledIndex(h);
         const std::uint64_t scramble = mix64(h);
-        return {unitFloat(reverseBits(index) ^ std::uint32_t(scramble)),
-                unitFloat(sobolSecond(index) ^ std::uint32_t(scramble >> 32))};
+        return {unitFloat(reverseBits(laineKarras(index, std::uint32_t(scramble)))),
+                unitFloat(owenScramble(sobolSecond(index), std::uint32_t(scramble >> 32)))};
     }
 
 private:
@@ -103,9 +139,13 @@ private:
         return mix64(pixelKey_ ^ (++dimension_ * 0x9E3779B97F4A7C15ULL));
     }
 
+    /// This request's sample index: owenScramble(sample) under the request's own seed.
+    std::uint32_t shuffledIndex(std::uint64_t h) const {
+        return reverseBits(laineKarras(reversedSample_, std::uint32_t(h)));
+    }
+
     std::uint64_t pixelKey_;
-    std::uint32_t sample_;
-    std::uint32_t indexMask_;
+    std::uint32_t reversedSample_;
     std::uint64_t dimension_ = 0;
 };
 
@@ -988,7 +1028,7 @@ Vec3 EmbreeRenderer::Impl::samplePixel(const Tracer& tracer, const CameraRays& c
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double sumSquares = 0.0;
     for (int s = 0; s < spp; ++s) {
-        Sampler rng(pixel ^ tracer.seedKey, std::uint32_t(s), std::uint32_t(spp));
+        Sampler rng(pixel ^ tracer.seedKey, std::uint32_t(s));
         const auto [jx, jy] = rng.next2D();
         const Eigen::Vector3d c =
             tracer.radiance(camera.origin, camera.direction(x, y, jx, jy), rng, rays)

@@ -279,5 +279,19 @@ check "--out naming a file refused" run 2 run scenes/stretch.toml --out "$tmp/a_
 check "--out naming a file says so" grep -q "^--out .*a_file: error: expected an output folder, found a file" "$tmp/stderr"
 check "--out naming a file leaves it empty" test ! -s "$tmp/a_file"
 
+# scripts/final_frames.sh: the last frame of each scene at final quality (here a coarse
+# dx_final and a short run, so the check takes a second).
+final_frames() {
+    OUT="$tmp/final" REND="$rend" SIZE=64x36 SPP=2 \
+        REND_ARGS="--set sheet.dx_final=0.04 --set time.duration=0.5" \
+        scripts/final_frames.sh scenes/seaweed.toml >"$tmp/final.txt"
+}
+check "final_frames runs" final_frames
+check "final_frames renders the last frame" cmp -s "$tmp/final/seaweed.png" \
+    "$tmp/final/seaweed/frames/frame_0012.png"
+check "final_frames writes no other frame" test ! -e "$tmp/final/seaweed/frames/frame_0011.png"
+check "final_frames reports the run" \
+    grep -qE "^seaweed: 2929 particles, [0-9]+ steps, [1-9][0-9]* broken bonds" "$tmp/final.txt"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -57,36 +57,37 @@ std::uint32_t reverseBits(std::uint32_t x) {
     return ((x & 0x55555555u) << 1) | ((x & 0xAAAAAAAAu) >> 1);
 }
 
-/// Second dimension of the Sobol sequence: its generator matrix is Pascal's triangle mod 2,
-/// whose columns follow v_{k+1} = v_k ^ (v_k >> 1). With the van der Corput first dimension
-/// the pair is a (0, 2)-sequence: every aligned block of 2^k points stratifies the unit square.
-/// The columns' XOR for each value of each byte of the index is tabulated, so a shuffled index
-/// with high bits set costs four look-ups, not a loop over 32 bits.
+/// Second dimension of the Sobol sequence at the sample index whose bits reversed are `r`. Its
+/// generator matrix is Pascal's triangle mod 2, whose columns follow v_{k+1} = v_k ^ (v_k >> 1);
+/// with the van der Corput first dimension (which is r itself) the pair is a (0, 2)-sequence:
+/// every aligned block of 2^k points stratifies the unit square. The columns' XOR for each
+/// value of each byte of r is tabulated: four look-ups, however many bits the index has.
 constexpr std::array<std::array<std::uint32_t, 256>, 4> sobolSecondTables() {
-    std::array<std::array<std::uint32_t, 256>, 4> tables{};
+    std::array<std::uint32_t, 32> columns{};
     std::uint32_t column = 1u << 31;
-    for (int byte = 0; byte < 4; ++byte) {
-        std::array<std::uint32_t, 8> columns{};
-        for (std::uint32_t& c : columns) {
-            c = column;
-            column ^= column >> 1;
-        }
-        for (std::uint32_t value = 0; value < 256; ++value)
-            for (int bit = 0; bit < 8; ++bit)
-                if (value & (1u << bit)) tables[byte][value] ^= columns[bit];
+    for (std::uint32_t& c : columns) {
+        c = column;
+        column ^= column >> 1;
     }
+    std::array<std::array<std::uint32_t, 256>, 4> tables{};
+    for (int byte = 0; byte < 4; ++byte)
+        for (std::uint32_t value = 0; value < 256; ++value)
+            for (int bit = 0; bit < 8; ++bit)  // bit b of r is bit 31 - b of the index
+                if (value & (1u << bit)) tables[byte][value] ^= columns[31 - (8 * byte + bit)];
     return tables;
 }
 
 constexpr auto kSobolSecond = sobolSecondTables();
 
-std::uint32_t sobolSecond(std::uint32_t index) {
-    return kSobolSecond[0][index & 0xFFu] ^ kSobolSecond[1][(index >> 8) & 0xFFu] ^
-           kSobolSecond[2][(index >> 16) & 0xFFu] ^ kSobolSecond[3][index >> 24];
+std::uint32_t sobolSecondOfReversed(std::uint32_t r) {
+    return kSobolSecond[0][r & 0xFFu] ^ kSobolSecond[1][(r >> 8) & 0xFFu] ^
+           kSobolSecond[2][(r >> 16) & 0xFFu] ^ kSobolSecond[3][r >> 24];
 }
 
 /// Laine & Karras's permutation with Burley's constants ("Practical Hash-based Owen Scrambling",
-/// JCGT 2020): bit k of the result depends only on bits 0..k of `x` and on the seed.
+/// JCGT 2020): bit k of the result depends only on bits 0..k of `x` and on the seed. On a
+/// bit-reversed sample index it is a nested uniform scramble: an aligned block of 2^k indices
+/// (a (0, k, 2)-net of the sequence) is shuffled among itself.
 std::uint32_t laineKarras(std::uint32_t x, std::uint32_t seed) {
     x += seed;
     x ^= x * 0x6c50b47cu;
@@ -96,24 +97,17 @@ std::uint32_t laineKarras(std::uint32_t x, std::uint32_t seed) {
     return x;
 }
 
-/// A nested uniform (Owen) scramble of a 32-bit fraction: each digit is flipped by a hash of
-/// the digits above it. Keeps every net property of the points it scrambles; applied to a
-/// sample index it shuffles an aligned power-of-two block of indices among themselves.
-std::uint32_t owenScramble(std::uint32_t x, std::uint32_t seed) {
-    return reverseBits(laineKarras(reverseBits(x), seed));
-}
-
 float unitFloat(std::uint32_t bits) { return float(bits >> 8) * 0x1p-24f; }  // [0, 1), never 1
 
 /// Random numbers of one (pixel, sample) path, a pure function of (pixel, sample, dimension):
 /// the n-th request of a path always gets the same value, so a pixel never depends on which
 /// thread renders it, or in which order. Each request (camera jitter, sun cone, lobe choice,
-/// BSDF lobe shape, roulette) is a point of the Sobol (0, 2)-sequence, Owen-scrambled per pixel
-/// and request, whose sample index is itself Owen-scrambled per request (Burley 2020's padded
-/// Sobol). The index shuffle is what makes the requests independent of one another: a digit
-/// XOR on the index would commute with the sequence's linear digits, every request would be a
-/// fixed function of the first, and a pixel would converge to a value of its own instead of
-/// the integral (an error that no sample count removes).
+/// BSDF lobe shape, roulette) is a point of the Sobol (0, 2)-sequence, randomised per pixel and
+/// request by a digit XOR (a random digital shift, which keeps the stratification), at a sample
+/// index shuffled per request by a nested uniform (Owen) scramble (Burley 2020's padded Sobol,
+/// with the Laine-Karras hash). The shuffle is non-linear on purpose: a digit XOR on the index
+/// would commute with the sequence's linear digits, every request would be a fixed function of
+/// the first, and a pixel would converge to a value of its own instead of the integral.
 class Sampler {
 public:
     Sampler(std::uint64_t pixel, std::uint32_t sample)
@@ -121,16 +115,15 @@ public:
 
     float next1D() {
         const std::uint64_t h = dimensionHash();
-        // owenScramble(reverseBits(i), s) is reverseBits(laineKarras(i, s)).
-        return unitFloat(reverseBits(laineKarras(shuffledIndex(h), std::uint32_t(h >> 32))));
+        return unitFloat(reversedIndex(h) ^ std::uint32_t(h >> 32));
     }
 
     std::array<float, 2> next2D() {
         const std::uint64_t h = dimensionHash();
-        const std::uint32_t index = shuffledIndex(h);
-        const std::uint64_t scramble = mix64(h);
-        return {unitFloat(reverseBits(laineKarras(index, std::uint32_t(scramble)))),
-                unitFloat(owenScramble(sobolSecond(index), std::uint32_t(scramble >> 32)))};
+        const std::uint32_t r = reversedIndex(h);
+        const std::uint64_t shift = mix64(h);
+        return {unitFloat(r ^ std::uint32_t(shift)),
+                unitFloat(sobolSecondOfReversed(r) ^ std::uint32_t(shift >> 32))};
     }
 
 private:
@@ -139,9 +132,10 @@ private:
         return mix64(pixelKey_ ^ (++dimension_ * 0x9E3779B97F4A7C15ULL));
     }
 
-    /// This request's sample index: owenScramble(sample) under the request's own seed.
-    std::uint32_t shuffledIndex(std::uint64_t h) const {
-        return reverseBits(laineKarras(reversedSample_, std::uint32_t(h)));
+    /// This request's sample index, Owen-scrambled under the request's own seed, bit-reversed
+    /// (which is its van der Corput point).
+    std::uint32_t reversedIndex(std::uint64_t h) const {
+        return laineKarras(reversedSample_, std::uint32_t(h));
     }
 
     std::uint64_t pixelKey_;

@@ -274,7 +274,7 @@ TEST(EmbreeRenderer, AMirrorShowsTheSunAtFourSamplesAsAtTwoHundredFiftySix) {
 TEST(EmbreeRenderer, EveryPixelConvergesToTheSameImageWhateverTheSeed) {
     // Two seeds' images differ by v/N + v/M in mean square when each pixel's estimate converges
     // to the integral: from 4 to 64 samples against a 256-sample reference of another seed the
-    // RMS difference falls 3.6-fold for independent samples, more with stratification (4.2).
+    // RMS difference falls 3.6-fold for independent samples, more with stratification (3.9).
     // When the path's random numbers are fixed functions of one another (a digit XOR on the
     // sample index did that), each pixel converges to a value of its own and the difference
     // stalls: 2.6-fold here, 1.4-fold on the torn foil from 16 to 256 samples.

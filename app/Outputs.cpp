@@ -8,6 +8,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "app/SceneNames.h"
 #include "app/SceneReader.h"
 
 namespace rend {
@@ -181,6 +182,18 @@ std::string jsonStringArray(const std::vector<std::string>& items, const std::st
     for (std::size_t k = 0; k < items.size(); ++k)
         out += (k ? ",\n" : "\n") + indent + "  " + jsonString(items[k]);
     return out + "\n" + indent + "]";
+}
+
+std::string shadingJson(const render::RenderSettings& settings) {
+    const render::PathTracing& pt = settings.pathTracing;
+    std::ostringstream j;
+    j.precision(6);
+    j << "{\"look\": " << jsonString(std::string(names::kLooks[std::size_t(settings.look)]))
+      << ", \"material\": " << jsonString(std::string(names::kMaterials[std::size_t(pt.material)]))
+      << ", \"albedo\": [" << settings.albedo.x() << ", " << settings.albedo.y() << ", "
+      << settings.albedo.z() << "], \"roughness\": " << pt.roughness
+      << ", \"transmission\": " << pt.transmission << "}";
+    return j.str();
 }
 
 }  // namespace rend

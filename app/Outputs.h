@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/AtomicFile.h"
+#include "render/RenderSettings.h"
 
 namespace rend {
 
@@ -81,5 +82,11 @@ std::string jsonString(const std::string& text);
 
 /// A JSON array of strings, one per line at the given indent.
 std::string jsonStringArray(const std::vector<std::string>& items, const std::string& indent);
+
+/// The membrane's material as the renderers resolve it, the look's preset under the scene's own
+/// keys: {"look", "material", "albedo", "roughness", "transmission"}. run.json carries it as
+/// "shading", so scripts/blender_import.py gives Cycles the same material (the resolved scene
+/// has only the keys the file wrote, not the look's defaults).
+std::string shadingJson(const render::RenderSettings& settings);
 
 }  // namespace rend

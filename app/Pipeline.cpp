@@ -190,6 +190,7 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
       << "  \"state_hash\": " << jsonString(hash) << ",\n"
       << "  \"files\": " << jsonStringArray(files, "  ") << ",\n"
+      << "  \"shading\": " << shadingJson(scene.render) << ",\n"
       << "  \"resolved_scene\": " << (scene.resolvedJson.empty() ? "{}" : scene.resolvedJson)
       << "\n}\n";
     return j.str();

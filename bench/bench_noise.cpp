@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "app/Outputs.h"
 #include "app/Pipeline.h"
 #include "render/EmbreeRenderer.h"
 #include "render/ExrWriter.h"
@@ -88,7 +89,8 @@ int renderCommand(int argc, char** argv) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%04d.ply", frame);
     rend::render::exportMesh(mesh, out / "meshes" / name, rend::render::MeshFormat::Ply);
-    std::ofstream(out / "run.json") << "{\"resolved_scene\": " << scene.resolvedJson << "}\n";
+    std::ofstream(out / "run.json") << "{\"shading\": " << rend::shadingJson(scene.render)
+                                    << ", \"resolved_scene\": " << scene.resolvedJson << "}\n";
     std::printf("rend threads=%d triangles=%zu\n", omp_get_max_threads(), mesh.triangles.size());
     for (int k = 7; k < argc; ++k) {
         // "ref=N": the reference, with another seed, so that its noise is independent of the

@@ -202,11 +202,15 @@ def render_exr_series(scene, counts, exr_dir):
 
 def main():
     args = parse_args()
-    scene_json = json.loads((args.out_dir / "run.json").read_text())["resolved_scene"]
+    run = json.loads((args.out_dir / "run.json").read_text())
+    scene_json = run["resolved_scene"]
     render = scene_json.get("render", {})
     background = render.get("background", [0.80, 0.84, 0.90])
     clear_scene()
-    count = import_sequence(args.out_dir / "meshes", vertex_colour_material(render))
+    # "shading" is the material as rend resolved it (the look's preset under the scene's keys);
+    # the resolved scene alone lacks the look's defaults.
+    count = import_sequence(args.out_dir / "meshes",
+                            vertex_colour_material(run.get("shading", render)))
     add_camera(scene_json.get("camera", {}))
     add_lights(scene_json.get("light", {}), render, background)
     add_ground(render, scene_json.get("sheet", {}))

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <system_error>
 
+#include "app/Scene.h"
+
 namespace fs = std::filesystem;
 using namespace rend;
 
@@ -100,4 +102,17 @@ TEST(StatsWriter, FinishRenamesTheRowsIntoPlace) {
     std::getline(in, row);
     EXPECT_EQ(row, "1,0.5,1,2,3,0,7");
     EXPECT_FALSE(fs::exists(dir / "stats.csv.partial"));
+}
+
+TEST(RunJson, ShadingIsTheLooksMaterialUnderTheScenesOwnKeys) {
+    // The resolved scene has only the keys a file wrote; "shading" is what the renderers use,
+    // which scripts/blender_import.py gives Cycles.
+    const fs::path foil = fs::path(REND_SOURCE_DIR) / "scenes" / "foil_tear.toml";
+    const std::string preset = shadingJson(loadScene(foil).render);
+    EXPECT_NE(preset.find("\"look\": \"foil\""), std::string::npos) << preset;
+    EXPECT_NE(preset.find("\"material\": \"conductor\""), std::string::npos) << preset;
+    EXPECT_NE(preset.find("\"roughness\": 0.22"), std::string::npos) << preset;
+    const std::string rough = shadingJson(loadScene(foil, {"render.roughness=0.5"}).render);
+    EXPECT_NE(rough.find("\"roughness\": 0.5,"), std::string::npos) << rough;
+    EXPECT_NE(rough.find("\"material\": \"conductor\""), std::string::npos) << rough;
 }

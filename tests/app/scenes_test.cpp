@@ -83,6 +83,19 @@ TEST(Scenes, EveryShippedSceneRunsShortenedWithoutNonFiniteValues) {
     }
 }
 
+TEST(Scenes, EveryShippedSceneSetsUpAndStepsAtFinalQuality) {
+    // quality = "final": at least a quarter of a million particles per sheet, every boundary
+    // region, notch and source found at the fine spacing, and the first steps finite.
+    for (const std::string& name : shippedScenes()) {
+        const Scene scene = loadScene(sceneFile(name), {"sheet.quality=\"final\""});
+        ASSERT_EQ(scene.quality, Quality::Final) << name;
+        sim::Membrane m = prepareMembrane(scene);
+        EXPECT_GE(std::size_t(m.particleCount()), kFinalParticles) << name;
+        for (int s = 0; s < 3; ++s) ASSERT_NO_THROW(m.step()) << name;
+        EXPECT_TRUE(allFinite(m)) << name;
+    }
+}
+
 TEST(Scenes, CrackPathIsMirrorSymmetricWithoutDiffusionAndNotWithTwoUnequalSources) {
     const sim::Membrane plain = runCrackPath("crack_path");
     const sim::Membrane sources = runCrackPath("crack_path_sources");

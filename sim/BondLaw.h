@@ -75,6 +75,7 @@ struct BondLaw {
 
     /// s^k for the power law: std::pow costs ~50 ns, most scenes use a small whole exponent.
     static double power(double s, double k) {
+        if (k == 0.0) return 1.0;
         if (k == 1.0) return s;
         if (k == 2.0) return s * s;
         if (k == 3.0) return s * s * s;

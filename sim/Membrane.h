@@ -62,10 +62,13 @@ public:
     double largestTimeStep() const { return dtMax_; }
     /// The stable bound now: the rest one over the square root of the last stiffening.
     double currentStableTimeStep() const;
-    /// The adaptive step's stretch measure, the same for every solver: over the intact bonds of
-    /// the bond families (every pair within R) loaded past half the critical stretch, the
-    /// largest |ds/dt| / eta_c [1/s], s = |x_j - x_i| / |x0_j - x0_i| - 1. 0 when nothing breaks.
-    double criticalStretchRate() const;
+    /// The adaptive step's fracture measure, the same for every solver: over the intact bonds of
+    /// the bond families (every pair within R) loaded past half the critical stretch and
+    /// stretching, the largest (ds/dt) / max(eta_c - s, delta eta_c) [1/s], with
+    /// s = |x_j - x_i| / |x0_j - x0_i| - 1 - alpha theta and delta = max_stretch_increment: one
+    /// over the shortest time in which a bond reaches eta_c, or overshoots it by delta eta_c. 0
+    /// when nothing breaks.
+    double failureApproachRate() const;
     /// The eta_c that scales it: the continuum's calibrated sqrt(2 pi G_f / (3 E R)) (Fracture.h),
     /// infinite without a fracture energy.
     double referenceCriticalStretch() const { return criticalStretch_; }
@@ -173,6 +176,7 @@ private:
     std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
     double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
+    double lastDrift_ = 0.0;   ///< the last symplectic Euler drift, 0 before the first
     TimeStepController controller_;
     double criticalStretch_ = std::numeric_limits<double>::infinity();
     bool adaptiveStep_ = false;  ///< step() runs inside advanceTo (the guard's advice)

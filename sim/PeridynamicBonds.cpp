@@ -156,9 +156,9 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const Eigen::Vector3d* v = s.v.data();
     const double dt = s.dt;
     const double expansion = material_.expansion();
-    double lowest = 0.0;  // the most compressed bond's strain, for the power law's step
+    double stiffest = 1.0;  // the stiffest compressed bond's tangent over c, for the power law
     int breaking = 0;
-#pragma omp parallel for schedule(static) reduction(min : lowest) reduction(+ : breaking) if ( \
+#pragma omp parallel for schedule(static) reduction(max : stiffest) reduction(+ : breaking) if ( \
         n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -188,9 +188,14 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
                 if constexpr (kUpdateBonds) plastic[b] = state;
             }
             if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
-                if (eta < 0.0) {  // where this compressed bond will be in dt, if it closes
+                if (eta < 0.0) {  // its tangent where it will be in dt, if it closes
                     const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
-                    lowest = std::min(lowest, eta + std::min(0.0, dt * rate));
+                    double tangent =
+                        law_.powerLawStiffening(clampCompression(eta + std::min(0.0, dt * rate)));
+                    // A dissolved bond (theta past 1 / stiffness_loss) is squashed by its own
+                    // swelling, yet carries no force: only the stiffness it has counts.
+                    if constexpr (kTheta) tangent *= material_.stiffnessFactor(thetaBar);
+                    stiffest = std::max(stiffest, tangent);
                 }
             }
             double f = law_.forceAs<kLaw>(eta, state);
@@ -200,7 +205,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
         force[i] = sum;
     }
     updates.breaking = breaking;
-    updates.lowest = lowest;
+    updates.stiffest = stiffest;
 }
 
 template <bool kUpdateBonds>
@@ -236,8 +241,7 @@ void PeridynamicBonds::advance(const StepState& s, Workspace&,
     Updates updates{plastic_.data(), damage_->proposals()};
     bondForces<true>(s, force, updates);
     if (updates.breaking > 0) damage_->applyProposals();
-    if (law_.kind == BondLawKind::PowerLaw)
-        stiffening_ = std::max(1.0, law_.powerLawStiffening(clampCompression(updates.lowest)));
+    if (law_.kind == BondLawKind::PowerLaw) stiffening_ = updates.stiffest;
 }
 
 void PeridynamicBonds::reportStrength(DamageState& damage) const {

@@ -58,8 +58,8 @@ private:
     struct Updates {
         PlasticState* plastic = nullptr;
         std::uint8_t* proposed = nullptr;
-        int breaking = 0;     ///< out: the bonds proposed
-        double lowest = 0.0;  ///< out: the most compressed bond's look-ahead strain
+        int breaking = 0;       ///< out: the bonds proposed
+        double stiffest = 1.0;  ///< out: the largest look-ahead tangent x stiffness factor, over c
     };
     /// The force loop for the scene's law.
     template <bool kUpdateBonds>

@@ -12,15 +12,13 @@ constexpr double kSmallest = 1.0 / 64;
 }  // namespace
 
 TimeStepController::TimeStepController(const TimeParams& time)
-    : safety_(std::min(time.safety, kMostOfBound)),
-      maxIncrement_(time.maxStretchIncrement),
-      burstBonds_(double(time.burstBonds)) {}
+    : safety_(std::min(time.safety, kMostOfBound)), burstBonds_(double(time.burstBonds)) {}
 
 double TimeStepController::next(double stableDt) {
     double dt = safety_ * stableDt;
     StepLimit limit = StepLimit::Bound;
-    if (stretchRate_ * dt > maxIncrement_) {
-        dt = maxIncrement_ / stretchRate_;
+    if (failureRate_ * dt > 1.0) {
+        dt = 1.0 / failureRate_;
         limit = StepLimit::Stretch;
     }
     if (cap_ < dt) {
@@ -34,8 +32,8 @@ double TimeStepController::next(double stableDt) {
     return dt;
 }
 
-void TimeStepController::record(double taken, std::size_t broken, double stretchRate) {
-    stretchRate_ = stretchRate;
+void TimeStepController::record(double taken, std::size_t broken, double failureRate) {
+    failureRate_ = failureRate;
     largestBurst_ = std::max(largestBurst_, broken);
     cap_ = kGrowth * wanted_;
     burst_ = false;

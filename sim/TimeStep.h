@@ -4,9 +4,12 @@
 // running crack scattered: a step that moves a crack tip past several bonds at once decides
 // their order by the step, not by the physics. So each step takes
 //
-//     dt = min(min(safety, 0.5) x bound,            stability (Silling & Askari 2005), accuracy
-//              max_stretch_increment / max |ds/dt|, no intact bond's stretch s jumps far
-//              burst cap)                           a step that broke many bonds shrinks the next
+//     dt = min(min(safety, 0.5) x bound,                    stability (Silling & Askari 2005)
+//              min over loaded bonds with ds/dt > 0 of       accuracy: no bond reaches eta_c
+//                max(eta_c - s, delta eta_c) / (ds/dt),      early, or overshoots it by more
+//                                                            than delta = max_stretch_increment
+//              burst cap)                                    a step that broke many bonds
+//                                                            shrinks the next
 //
 // and never grows by more than kGrowth over the step before, nor falls below 1/64 of the first
 // term. Half the bound, not auto's 0.8: a step near the bound is stable but integrates the
@@ -15,10 +18,10 @@
 // crack of crack_path_sources stalls for 0.19 s after four bonds, then kinks off its line; at
 // 0.35-0.7 it breaks the same bonds as at a quarter of the stretch increment (README "Adaptive
 // time step"). The bound is the rest one over the square root of the solver's stiffening (the power
-// law in compression), recomputed every step. The stretch rate is measured on the Membrane's bond
-// families (every particle pair within the cutoff R), which every solver has, so the same limit
-// serves the bonds, the elements, the springs and SPH alike; breaks are the DamageState's broken
-// bonds and removed triangles.
+// law in compression), recomputed every step. The time to failure is measured on the Membrane's
+// bond families (every particle pair within the cutoff R), which every solver has, so the same
+// limit serves the bonds, the elements, the springs and SPH alike; breaks are the DamageState's
+// broken bonds and removed triangles.
 //
 // Inputs are a maximum and counts, which no thread count changes: the steps, and so the run,
 // are bitwise identical for any number of threads.
@@ -47,8 +50,9 @@ public:
     /// The step wanted next, given the stable bound now (rest bound / sqrt(stiffening)).
     double next(double stableDt);
     /// After a step of `taken` seconds (at most what next() wanted, less where a frame ended),
-    /// which broke `broken` bonds and left `stretchRate` = max |ds/dt| over intact bonds.
-    void record(double taken, std::size_t broken, double stretchRate);
+    /// which broke `broken` bonds and left `failureRate` = one over the shortest time in which a
+    /// bond reaches its critical stretch (Membrane::failureApproachRate).
+    void record(double taken, std::size_t broken, double failureRate);
 
     StepLimit lastLimit() const { return lastLimit_; }
     /// Steps each limit chose, indexed by StepLimit.
@@ -58,10 +62,9 @@ public:
 
 private:
     double safety_ = kMostOfBound;
-    double maxIncrement_ = 1e-3;
     double burstBonds_ = 8;
-    double stretchRate_ = 0.0;
-    double wanted_ = 0.0;                                   ///< what next() last returned
+    double failureRate_ = 0.0;  ///< 1 / the shortest time for a bond to fail
+    double wanted_ = 0.0;       ///< what next() last returned
     double cap_ = std::numeric_limits<double>::infinity();  ///< growth and burst limits
     bool burst_ = false;  ///< cap_ comes from a burst, not from growth
     StepLimit lastLimit_ = StepLimit::Bound;

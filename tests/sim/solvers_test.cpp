@@ -160,6 +160,19 @@ TEST(Solvers, ThePeridynamicBondsAreASolverOnTheMembranesOwnBonds) {
     f = rubber.advanceAt(x, v, 1e-3);
     EXPECT_NEAR(rubber.stiffening(), rubber.law().powerLawStiffening(-0.2), 1e-9)
         << "the most compressed bond sets the sub-steps";
+    p.material.stiffnessLoss = 5.0;  // dissolved past theta = 0.2
+    PeridynamicBonds dissolved(p, lattice, shared, lattice.positions, volumes);
+    dissolved.bind(shared, intact);
+    for (auto& xi : x) xi *= 0.625;  // 50% compression
+    std::vector<double> theta(x.size(), 0.25);
+    theta[0] =
+        0.05;  // theta-bar 0.15 on its bonds: a quarter of the stiffness, and only they count
+    std::vector<Eigen::Vector3d> force;
+    dissolved.advance({x, v, theta, 1e-3}, *dissolved.makeWorkspace(), force);
+    const double quarter = 0.25 * dissolved.law().powerLawStiffening(-0.5);
+    ASSERT_GT(quarter, 2.0);
+    EXPECT_NEAR(dissolved.stiffening(), quarter, 1e-9 * quarter)
+        << "a dissolved bond, squashed but carrying no force, does not cut the step";
 
     p.material.law = BondLawKind::Elastoplastic;
     p.material.yieldStrain = 0.01;

@@ -285,8 +285,8 @@ constexpr Param kTimeKeys[] = {
      "0.5 of it, lower when set lower",
      "0.8"},
     {"max_stretch_increment", T::Number, Range::openClosed(0.0, 1.0), "0.02",
-     "adaptive dt: the most a step may carry a bond past its critical stretch, as a fraction "
-     "of it (no step is longer than the time a loaded bond takes to reach it, or this past it)",
+     "adaptive dt: near breaking, the most one step may stretch a loaded bond, as a fraction of "
+     "its critical stretch (farther away, a step may close half the bond's way to breaking)",
      "0.05"},
     {"burst_bonds", T::Integer, closed(1, 1e6), "8",
      "adaptive dt: a step that breaks more bonds shrinks the next (by the excess, regrowing "

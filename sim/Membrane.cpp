@@ -256,11 +256,11 @@ double Membrane::currentStableTimeStep() const {
 }
 
 // Only bonds that a step could carry past eta_c count. A bond loaded past eta_c / 2 and
-// stretching at ds/dt > 0 reaches eta_c after (eta_c - s) / (ds/dt); a step no longer than that
-// breaks nothing early, and near eta_c a step of delta eta_c / (ds/dt) overshoots by at most
-// delta eta_c (delta = max_stretch_increment). So a step resolves the order in which bonds near
-// a crack tip break, while the ringing of bonds far from eta_c, loaded or not (swelling patches,
-// a lattice-scale mode), does not set it: the bound keeps that stable.
+// stretching at ds/dt > 0 has eta_c - s to go. A step closes at most half of that (so a bond whose
+// stretch accelerates is not carried far past eta_c in one step), and near eta_c at most
+// delta eta_c (delta = max_stretch_increment): about five steps bring a bond from eta_c / 2 to
+// breaking, in order with its neighbours. A loaded bond far from eta_c does not set the step
+// however fast it rings (swelling patches, lattice-scale modes): the bound keeps that stable.
 double Membrane::failureApproachRate() const {
     if (!std::isfinite(criticalStretch_)) return 0.0;
     const int n = particleCount();
@@ -286,7 +286,7 @@ double Membrane::failureApproachRate() const {
             const double rate = xi.dot(v_[j] - v_[i]) / (length * rest);  // ds/dt
             if (!(rate > 0.0)) continue;
             const double margin = critical - (length / rest - unstretched);
-            fastest = std::max(fastest, rate / std::max(margin, delta * critical));
+            fastest = std::max(fastest, rate / std::max(0.5 * margin, delta * critical));
         }
     }
     return fastest;

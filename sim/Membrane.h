@@ -64,10 +64,10 @@ public:
     double currentStableTimeStep() const;
     /// The adaptive step's fracture measure, the same for every solver: over the intact bonds of
     /// the bond families (every pair within R) loaded past half the critical stretch and
-    /// stretching, the largest (ds/dt) / max(eta_c - s, delta eta_c) [1/s], with
+    /// stretching, the largest (ds/dt) / max((eta_c - s) / 2, delta eta_c) [1/s], with
     /// s = |x_j - x_i| / |x0_j - x0_i| - 1 - alpha theta and delta = max_stretch_increment: one
-    /// over the shortest time in which a bond reaches eta_c, or overshoots it by delta eta_c. 0
-    /// when nothing breaks.
+    /// over the shortest time in which a bond closes half its way to eta_c, or delta eta_c of it.
+    /// 0 when nothing breaks.
     double failureApproachRate() const;
     /// The eta_c that scales it: the continuum's calibrated sqrt(2 pi G_f / (3 E R)) (Fracture.h),
     /// infinite without a fracture energy.

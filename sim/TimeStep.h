@@ -5,9 +5,10 @@
 // their order by the step, not by the physics. So each step takes
 //
 //     dt = min(min(safety, 0.5) x bound,                    stability (Silling & Askari 2005)
-//              min over loaded bonds with ds/dt > 0 of       accuracy: no bond reaches eta_c
-//                max(eta_c - s, delta eta_c) / (ds/dt),      early, or overshoots it by more
-//                                                            than delta = max_stretch_increment
+//              min over loaded bonds with ds/dt > 0 of       accuracy: no bond jumps to eta_c
+//                max((eta_c - s) / 2, delta eta_c) / (ds/dt) a step closes at most half a
+//                                                            bond's way to eta_c, or delta =
+//                                                            max_stretch_increment of eta_c
 //              burst cap)                                    a step that broke many bonds
 //                                                            shrinks the next
 //

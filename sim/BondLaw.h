@@ -73,6 +73,10 @@ struct BondLaw {
 
     double stiffness() const { return c; }
 
+    /// The most compression the power law is evaluated at (a bond squashed to 5% of its
+    /// length): beyond it the push is held, and the explicit step's look-ahead stops there too.
+    static constexpr double kMostCompression = -0.95;
+
     /// s^k for the power law: std::pow costs ~50 ns, most scenes use a small whole exponent.
     static double power(double s, double k) {
         if (k == 0.0) return 1.0;
@@ -106,6 +110,11 @@ struct BondLaw {
         if constexpr (K == BondLawKind::Linear) {
             return c * eta;  // eq. 18
         } else if constexpr (K == BondLawKind::PowerLaw) {
+            // Past kMostCompression the push stays at its value there (the energy goes on
+            // linearly). Eq. 19 holds for s > 0 only: where the expansion alpha theta exceeds a
+            // squashed bond's length, s = 1 + eta < 0 and s - 1/s^3 turns the push into a pull
+            // that collapses the pair (the acid film's swollen shreds did).
+            eta = std::max(eta, kMostCompression);
             const double s = 1.0 + eta;  // eq. 19
             return 2.0 * powerC * (s - 1.0 / (s * s * s)) +
                    powerCStar * powerN * (power(s, powerN - 1.0) - 1.0);
@@ -142,9 +151,11 @@ struct BondLaw {
             case BondLawKind::Linear:
                 return 0.5 * c * eta * eta;  // eq. 12
             case BondLawKind::PowerLaw: {
-                const double s = 1.0 + eta;  // eq. 13
+                const double held = std::max(eta, kMostCompression);
+                const double s = 1.0 + held;  // eq. 13
                 return powerC * (s * s + 1.0 / (s * s) - 2.0) +
-                       powerCStar * (power(s, powerN) - 1.0 - powerN * eta);
+                       powerCStar * (power(s, powerN) - 1.0 - powerN * held) +
+                       (eta - held) * forceAs<BondLawKind::PowerLaw>(held);
             }
             case BondLawKind::Elastoplastic: {
                 const double e = eta - plasticStrain(p);  // eq. 14's recoverable part

@@ -17,7 +17,9 @@ inline double degradation(double loss, double theta) { return std::max(0.0, 1.0 
 
 /// A guard, not physics: the power law's look-ahead strain is held at -0.95 (a bond squashed
 /// to 5%) before its stiffening sets the sub-steps, whatever the solver.
-inline double clampCompression(double strain) { return std::max(strain, -0.95); }
+inline double clampCompression(double strain) {
+    return std::max(strain, BondLaw::kMostCompression);
+}
 
 class Material {
 public:

@@ -81,6 +81,22 @@ TEST(BondLaw, PowerLawRubberSoftensInTensionAndStiffensInCompression) {
     EXPECT_LT(law.force(-0.5), law.c * -0.5) << "1/s^3 resists collapse";
 }
 
+// Eq. 19 holds for s = 1 + eta > 0. Expansion can take a squashed bond's mechanical strain below
+// -1 (alpha theta larger than its length); there the law must still push, never pull.
+TEST(BondLaw, PowerLawPushesHowEverFarABondIsSquashed) {
+    const BondLaw law = lawOf(BondLawKind::PowerLaw);
+    const double held = law.force(BondLaw::kMostCompression);
+    EXPECT_LT(held, law.force(-0.5));
+    for (double eta : {-0.96, -1.0, -1.4, -3.0}) {
+        EXPECT_EQ(law.force(eta), held) << eta;
+        const double h = 1e-6;
+        EXPECT_NEAR((law.energy(eta + h) - law.energy(eta - h)) / (2 * h), held, 1e-6 * -held)
+            << "the energy goes on linearly, eta " << eta;
+    }
+    EXPECT_NEAR(law.energy(BondLaw::kMostCompression - 1e-9), law.energy(BondLaw::kMostCompression),
+                1e-6 * -held);
+}
+
 TEST(BondLaw, ElastoplasticLoadingFollowsEquationTwentyAndKeepsAPermanentSet) {
     const BondLaw law = lawOf(BondLawKind::Elastoplastic);  // eta0 = 0.01, beta = 0.5
     PlasticState state;

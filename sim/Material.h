@@ -15,8 +15,8 @@ namespace rend::sim {
 /// by max(0, 1 - loss * theta).
 inline double degradation(double loss, double theta) { return std::max(0.0, 1.0 - loss * theta); }
 
-/// A guard, not physics: the power law's look-ahead strain is held at -0.95 (a bond squashed
-/// to 5%) before its stiffening sets the sub-steps, whatever the solver.
+/// The power law's look-ahead strain is held at BondLaw::kMostCompression (a bond squashed to
+/// 5%, where its force is held too) before its stiffening sets the sub-steps, whatever the solver.
 inline double clampCompression(double strain) {
     return std::max(strain, BondLaw::kMostCompression);
 }

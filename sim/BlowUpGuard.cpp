@@ -141,7 +141,7 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
 void BlowUpGuard::addWork(const State& state, const Sample& s) {
     const double power =
         s.boundaryPower + s.gravityPower + pressureArea_ * std::sqrt(s.maxSpeedSquared);
-    budget_ += state.dt * power;
+    budget_ += state.dt * power + state.colliderWork;
 }
 
 void BlowUpGuard::check(const State& state, const std::function<double()>& totalEnergy) {
@@ -170,8 +170,8 @@ void BlowUpGuard::check(const State& state, const std::function<double()>& total
     else
         why << "the kinetic energy reached ";
     why << s.kinetic << " J, " << ratio
-        << " times the most the start state, the boundaries, gravity, pressure and expansion "
-           "can have put in ("
+        << " times the most the start state, the boundaries, gravity, pressure, expansion "
+           "and colliders can have put in ("
         << allowed << " J)";
     report(state, s, why.str());
 }

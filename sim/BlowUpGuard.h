@@ -66,7 +66,8 @@ public:
         std::span<const std::int16_t> constraint;
         long step = 0;
         double time = 0.0, dt = 0.0, stableDt = 0.0;
-        bool adaptive = false;  ///< the step came from the adaptive controller (sim/TimeStep.h)
+        bool adaptive = false;      ///< the step came from the adaptive controller (sim/TimeStep.h)
+        double colliderWork = 0.0;  ///< at most what moving colliders did on the sheet [J]
     };
     /// Checks the state after a step; throws NumericalBlowUp naming the step, the fastest (or
     /// first non-finite) particle and a suggested dt. `totalEnergy` (kinetic + strain) is

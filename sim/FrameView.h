@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <span>
 
+#include "sim/Collider.h"
+
 namespace rend::sim {
 
 struct FrameView {
@@ -41,6 +43,11 @@ struct FrameView {
     /// means none is. It tells a removed triangle from one whose edges broke, which the lattice
     /// surface cuts rather than drops.
     std::span<const std::uint8_t> triangleAlive;
+
+    /// The scene's colliders (sim/Collider.h) and, index for index, their poses at `time`; empty
+    /// without colliders. The ground plane is the render settings' own.
+    std::span<const ColliderParams> colliders;
+    std::span<const ColliderPose> colliderPoses;
 
     bool triangleKept(std::size_t t) const { return keptTriangles.empty() || keptTriangles[t]; }
 

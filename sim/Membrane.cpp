@@ -39,6 +39,7 @@ Membrane::Membrane(const MembraneParams& params)
         diffusion_.emplace(params, x0_, bonds_, volume_);
         theta_ = diffusion_->initialTheta();
     }
+    if (params.contact.any()) setUpContact(params);
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
     controller_ = TimeStepController(params.time);
     const MaterialParams& m = params.material;
@@ -87,6 +88,25 @@ void Membrane::assignBoundaries() {
         for (int i = 0; i < particleCount(); ++i)
             if (bc.region.contains(x0_[i])) constraint_[i] = tag;
     }
+}
+
+// The contact thickness d defaults to half the spacing, never below the sheet's thickness. The
+// self-contact's stiffness per unit mass at rest is a quarter of the stiffest rest row's
+// (2 / dt_stable^2), and at least what holds 8 layers of sheet under gravity within d / 4; the
+// stable bound then takes up to four such contacts at once (a particle's mass against a pair's
+// reduced mass of half of it).
+void Membrane::setUpContact(const MembraneParams& params) {
+    const SelfContactParams& self = params.contact.self;
+    const double thickness = self.thickness > 0.0
+                                 ? self.thickness
+                                 : std::max(0.5 * params.sheet.dx, params.sheet.thickness);
+    const double restRate = 2.0 / (stableDt_ * stableDt_);
+    const double baseRate =
+        std::max(0.25 * restRate, 4.0 * 8.0 * params.gravity.norm() / thickness);
+    contact_.emplace(params.contact, thickness, horizon_, baseRate, lattice_.triangles);
+    if (self.enabled) setStableStep(restRate + 2.0 * baseRate);
+    free_.resize(x0_.size());
+    for (std::size_t i = 0; i < x0_.size(); ++i) free_[i] = constraint_[i] == kFree;
 }
 
 int Membrane::nearestParticle(const Eigen::Vector2d& at) const {
@@ -138,7 +158,7 @@ void Membrane::kick(double h, double tNext) {
 
 void Membrane::checkFinite() {
     guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
-                  adaptiveStep_},
+                  adaptiveStep_, contact_ ? contact_->takeWork() : 0.0},
                  [this] { return kineticEnergy() + strainEnergy(); });
 }
 
@@ -160,12 +180,26 @@ void Membrane::integrate(double dt, double tNext) {
         updateVelocity(i, kickDt, tNext, gravity, damping);
         x_[i] += dt * v_[i];
     }
+    collide(tNext);
+}
+
+void Membrane::collide(double tNext) {
+    if (!contact_ || !contact_->hasColliders()) return;
+    contact_->place(tNext);
+    contact_->resolveColliders(x_, v_, mass_, free_);
+}
+
+double Membrane::contactStepLimit() const {
+    return contact_ ? contact_->stepLimit(maxSpeed()) : std::numeric_limits<double>::infinity();
 }
 
 void Membrane::accumulateForces() {
     solver_->advance(stepState(), *workspace_, force_);
     stiffening_ = solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
+    if (contact_ && contact_->selfContact())
+        contact_->addSelfContactForces({x_, v_, x0_, mass_, damageState_.keptTriangles(), dt_},
+                                       force_);
 }
 
 // Follower pressure: each kept triangle (DamageState::keptTriangles) pushes its three corners along
@@ -185,12 +219,18 @@ void Membrane::addPressure(std::vector<Eigen::Vector3d>& force) const {
     }
 }
 
+// A fixed step is also cut where contact needs it; an adaptive one was already chosen within the
+// contact's limit (advanceTo).
 int Membrane::piecesOfStep() {
-    if (stiffening_ <= 1.0) return 1;
+    const double contactPieces =
+        contact_ && !adaptiveStep_ ? std::ceil(dt_ / contactStepLimit() * (1.0 - 1e-12)) : 1.0;
+    if (stiffening_ <= 1.0 && contactPieces <= 1.0) return 1;
     // The bound scales as 1/sqrt(stiffness). Keep dt / bound within what was allowed at rest:
     // the safety factor, or the step's own ratio when it was set higher.
     const double allowed = std::max(params_.time.safety, dt_ / stableDt_) * stableDt_;
-    const double needed = std::ceil(dt_ * std::sqrt(stiffening_) / allowed * (1.0 - 1e-12));
+    const double needed =
+        std::max(contactPieces,
+                 std::ceil(dt_ * std::sqrt(std::max(1.0, stiffening_)) / allowed * (1.0 - 1e-12)));
     const int pieces = int(std::clamp(needed, 1.0, double(kMaxPieces)));
     subSteps_ += pieces - 1;
     return pieces;
@@ -238,6 +278,7 @@ void Membrane::step() {
     }
     time_ += dt_;
     ++steps_;
+    if (contact_) contact_->place(time_);
     dtMin_ = std::min(dtMin_, dt_);
     dtMax_ = std::max(dtMax_, dt_);
     checkFinite();
@@ -296,7 +337,8 @@ double Membrane::failureApproachRate() const {
 // few steps as the controller allows.
 void Membrane::advanceTo(double tEnd) {
     while (time_ < tEnd) {
-        const double wanted = controller_.next(currentStableTimeStep());
+        const double wanted =
+            std::min(controller_.next(currentStableTimeStep()), contactStepLimit());
         const double left = tEnd - time_;
         const double pieces = std::ceil(left / wanted * (1.0 - 1e-12));
         dt_ = pieces <= 1.0 ? left : left / pieces;
@@ -337,9 +379,11 @@ double Membrane::strainEnergy() const {
 }
 
 double Membrane::maxSpeed() const {
-    double m = 0.0;
-    for (const auto& v : v_) m = std::max(m, v.norm());
-    return m;
+    const int n = particleCount();
+    double fastest = 0.0;  // squared; a maximum is the same for any thread count
+#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) fastest = std::max(fastest, v_[i].squaredNorm());
+    return std::sqrt(fastest);
 }
 
 double Membrane::maxTheta() const {
@@ -370,6 +414,10 @@ FrameView Membrane::view(int frame) const {
     v.bondAlive = damageState_.bondAlive();
     v.keptTriangles = damageState_.keptTriangles();
     v.triangleAlive = damageState_.triangleAlive();
+    if (contact_) {
+        v.colliders = contact_->colliders();
+        v.colliderPoses = contact_->poses();
+    }
     return v;
 }
 

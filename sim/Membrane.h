@@ -18,6 +18,7 @@
 #include "sim/BlowUpGuard.h"
 #include "sim/BondLaw.h"
 #include "sim/Bonds.h"
+#include "sim/Contact.h"
 #include "sim/DamageState.h"
 #include "sim/Diffusion.h"
 #include "sim/Fracture.h"
@@ -36,6 +37,7 @@ public:
     explicit Membrane(const MembraneParams& params);
 
     int particleCount() const { return int(x0_.size()); }
+    const MembraneParams& params() const { return params_; }
     std::size_t bondCount() const { return bonds_.bondCount(); }
     double horizon() const { return horizon_; }
     /// The scene's solver (its own constants, e.g. PeridynamicBonds::criticalStretch(), are
@@ -73,6 +75,10 @@ public:
     /// infinite without a fracture energy.
     double referenceCriticalStretch() const { return criticalStretch_; }
     const TimeStepController& stepController() const { return controller_; }
+    /// Ground, colliders and self-contact (sim/Contact.h); nullptr when the scene has none.
+    const Contact* contact() const { return contact_ ? &*contact_ : nullptr; }
+    /// The longest step contact allows at the current speeds (infinite without contact).
+    double contactStepLimit() const;
 
     /// One explicit step (eq. 26): bond forces (breaking bonds past eta_c, yielding
     /// elastoplastic ones), then velocities, then positions, then theta. Throws
@@ -155,6 +161,9 @@ private:
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
     void integrate(double h, double tNext);
+    /// Contact after a drift to tNext: the colliders placed there push the free particles out.
+    void collide(double tNext);
+    void setUpContact(const MembraneParams& params);
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
     std::size_t breakCount() const;
@@ -166,6 +175,8 @@ private:
     bool canDamage_ = false;
     std::size_t notched_ = 0;
     std::optional<Diffusion> diffusion_;
+    std::optional<Contact> contact_;
+    std::vector<std::uint8_t> free_;  ///< per particle: 1 unless pinned or driven (contact only)
     double horizon_ = 0.0;
     double stableDt_ = 0.0;
     double dt_ = 0.0;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/Collider.h"
+
 namespace rend::sim {
 
 enum class LatticeKind { Hexagonal, Square };
@@ -183,6 +185,7 @@ struct MembraneParams {
     TimeParams time;
     std::vector<Notch> notches;
     DiffusionParams diffusion;
+    ContactParams contact;  ///< ground, colliders, self-contact (sim/Contact.h)
 };
 
 }  // namespace rend::sim

@@ -1,0 +1,346 @@
+#include "sim/Contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/Parallel.h"
+
+namespace rend::sim {
+namespace {
+
+/// Damping of the self-contact's normal force as a fraction of critical: a landing flap stops
+/// rather than bounces.
+constexpr double kContactDamping = 0.5;
+/// A particle closes on a neighbour by at most this fraction of d in a step.
+constexpr double kStepFraction = 0.25;
+/// The self-contact's stiffness follows the fastest particle: sqrt(rate) >= kStopping vmax / d
+/// stops two particles closing at 2 vmax within d / 2 (the spring's energy over d / 2 is
+/// (kStopping / 4)^2 times their kinetic energy), and with the step limit a contact's own
+/// frequency stays at sqrt(rate) dt <= kStopping kStepFraction / 2 = 0.625.
+constexpr double kStopping = 5.0;
+
+}  // namespace
+
+Contact::Contact(const ContactParams& params, double thickness, double horizon,
+                 double stiffnessRate, std::span<const std::array<int, 3>> triangles)
+    : params_(params),
+      thickness_(thickness),
+      offset_(0.5 * thickness),
+      baseStiffnessRate_(stiffnessRate) {
+    const double reach = horizon * (1.0 + 1e-9);  // the bond families' own reach (Bonds.cpp)
+    restExclusion2_ = reach * reach;
+    skin_ = thickness_;
+    if (params_.self.enabled) triangles_.assign(triangles.begin(), triangles.end());
+    meshes_.resize(params_.colliders.size());
+    for (std::size_t c = 0; c < params_.colliders.size(); ++c) {
+        const ColliderParams& collider = params_.colliders[c];
+        // Reach: the offset and a step's worth of approach (stepLimit keeps it under 2 d).
+        if (collider.shape == ColliderShape::Mesh && collider.mesh)
+            meshes_[c].emplace(*collider.mesh, 4.0 * thickness_);
+    }
+    place(0.0);
+}
+
+void Contact::place(double t) {
+    poses_.resize(params_.colliders.size());
+    for (std::size_t c = 0; c < poses_.size(); ++c) poses_[c] = params_.colliders[c].poseAt(t);
+}
+
+// Out to the offset along the normal; then the normal velocity relative to the surface is
+// removed if it approaches, and that removed speed bounds the friction: the tangential relative
+// velocity stops if it needs no more than stiction times it, else slows by kinetic times it.
+void Contact::pushOut(Eigen::Vector3d& x, Eigen::Vector3d& v, const SurfaceDistance& s,
+                      const Eigen::Vector3d& surfaceVelocity, const Friction& friction) const {
+    x += (offset_ - s.distance) * s.normal;
+    const Eigen::Vector3d relative = v - surfaceVelocity;
+    const double normalSpeed = relative.dot(s.normal);
+    if (normalSpeed >= 0.0) return;  // already leaving (a collider pushing it catches it up)
+    const Eigen::Vector3d tangential = relative - normalSpeed * s.normal;
+    const double slide = tangential.norm();
+    const double grip = -normalSpeed;
+    const double keep = slide <= friction.stiction * grip
+                            ? 0.0
+                            : std::max(0.0, 1.0 - friction.kinetic * grip / slide);
+    v = surfaceVelocity + keep * tangential;
+}
+
+void Contact::resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const {
+    const GroundParams& ground = params_.ground;
+    for (std::size_t c = 0; c < poses_.size(); ++c) {
+        const ColliderParams& collider = params_.colliders[c];
+        const ColliderPose& pose = poses_[c];
+        const std::optional<SurfaceDistance> local =
+            signedDistance(collider, meshes_[c] ? &*meshes_[c] : nullptr, pose.toLocal(x));
+        if (!local || local->distance >= offset_) continue;
+        const SurfaceDistance world{local->distance, pose.rotation * local->normal};
+        pushOut(x, v, world, pose.velocityAt(x), collider.friction);
+    }
+    // The ground last: whatever a collider did, nothing ends below it.
+    if (ground.enabled && x.z() < ground.height + offset_) {
+        const SurfaceDistance s{x.z() - ground.height, Eigen::Vector3d::UnitZ()};
+        pushOut(x, v, s, Eigen::Vector3d::Zero(), ground.friction);
+    }
+}
+
+void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
+                               std::span<const double> mass, std::span<const std::uint8_t> free) {
+    const int n = int(x.size());
+    impulse_.resize(std::size_t(n));
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d before = v[i];
+        if (free[i]) resolveParticle(x[i], v[i]);
+        impulse_[i] = mass[i] * (v[i] - before);
+    }
+    const double speed = colliderSpeed();
+    if (speed == 0.0) return;
+    double total = 0.0;  // in particle order
+    for (const Eigen::Vector3d& p : impulse_) total += p.norm();
+    work_ += speed * total;
+}
+
+double Contact::colliderSpeed() const {
+    double fastest = 0.0;
+    for (std::size_t c = 0; c < poses_.size(); ++c)
+        fastest =
+            std::max(fastest, poses_[c].velocity.norm() + poses_[c].angularVelocity.norm() *
+                                                              boundingRadius(params_.colliders[c]));
+    return fastest;
+}
+
+Eigen::Vector3d Contact::lastImpulse() const {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : impulse_) sum += p;
+    return sum;
+}
+
+double Contact::stepLimit(double maxSpeed) const {
+    double limit = std::numeric_limits<double>::infinity();
+    const double speed = colliderSpeed();
+    for (const ColliderParams& collider : params_.colliders) {
+        const double half =
+            collider.shape == ColliderShape::Mesh ? 2.0 * thickness_ : halfThickness(collider);
+        if (maxSpeed + speed > 0.0) limit = std::min(limit, half / (maxSpeed + speed));
+    }
+    if (params_.self.enabled && maxSpeed > 0.0)
+        limit = std::min(limit, kStepFraction * thickness_ / (2.0 * maxSpeed));
+    return limit;
+}
+
+// ---- self-contact ----------------------------------------------------------------------------
+
+namespace {
+
+/// Sorts the first `count` buckets and drops repeats (two cells may share a bucket); returns how
+/// many are left. Insertion sort: at most eight.
+int sortUnique(std::array<std::uint32_t, 8>& b, int count) {
+    for (int k = 1; k < count; ++k)
+        for (int j = k; j > 0 && b[j - 1] > b[j]; --j) std::swap(b[j - 1], b[j]);
+    int kept = 0;
+    for (int k = 0; k < count; ++k)
+        if (kept == 0 || b[kept - 1] != b[k]) b[kept++] = b[k];
+    return kept;
+}
+
+/// A spatial hash of points: cells of size 2 r, so the cube of half-width r about a query meets
+/// at most two cells along each axis; the items counting-sorted by bucket, ascending within one.
+class PointHash {
+public:
+    PointHash(std::span<const Eigen::Vector3d> points, double radius)
+        : radius_(radius), cell_(2.0 * radius) {
+        const std::size_t n = points.size();
+        std::uint32_t buckets = 1;
+        while (buckets < 2 * n) buckets <<= 1;
+        mask_ = buckets - 1;
+        std::vector<std::uint32_t> bucket(n);
+        for (std::size_t i = 0; i < n; ++i) bucket[i] = bucketOf(cellOf(points[i]));
+        start_.assign(std::size_t(buckets) + 1, 0);
+        for (std::size_t i = 0; i < n; ++i) ++start_[bucket[i] + 1];
+        for (std::uint32_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
+        items_.resize(n);
+        std::vector<int> fill(start_.begin(), start_.end() - 1);
+        for (std::size_t i = 0; i < n; ++i) items_[std::size_t(fill[bucket[i]]++)] = int(i);
+    }
+
+    /// Calls f(item) for every item in the buckets near x (a superset of those within r).
+    template <class F>
+    void near(const Eigen::Vector3d& x, F&& f) const {
+        std::array<std::uint32_t, 8> found{};
+        const Eigen::Vector3i lo = cellOf(x.array() - radius_), hi = cellOf(x.array() + radius_);
+        int count = 0;
+        for (int z = lo.z(); z <= hi.z(); ++z)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int c = lo.x(); c <= hi.x(); ++c) found[count++] = bucketOf({c, y, z});
+        count = sortUnique(found, count);
+        for (int k = 0; k < count; ++k)
+            for (int s = start_[found[k]]; s < start_[found[k] + 1]; ++s) f(items_[std::size_t(s)]);
+    }
+
+private:
+    Eigen::Vector3i cellOf(const Eigen::Vector3d& x) const {
+        return (x / cell_).array().floor().cast<int>();
+    }
+    std::uint32_t bucketOf(const Eigen::Vector3i& c) const {
+        const std::uint64_t h = std::uint64_t(std::int64_t(c.x())) * 73856093u ^
+                                std::uint64_t(std::int64_t(c.y())) * 19349663u ^
+                                std::uint64_t(std::int64_t(c.z())) * 83492791u;
+        return std::uint32_t(h ^ (h >> 32)) & mask_;
+    }
+
+    double radius_, cell_;
+    std::uint32_t mask_ = 0;
+    std::vector<int> start_, items_;
+};
+
+Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
+    return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
+}
+
+}  // namespace
+
+bool Contact::listStale(std::span<const Eigen::Vector3d> x) const {
+    if (builtAt_.size() != x.size()) return true;
+    const int n = int(x.size());
+    const double limit = 0.25 * skin_ * skin_;  // (skin / 2)^2
+    double moved = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : moved) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i]).squaredNorm());
+    return moved > limit;
+}
+
+bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
+                           std::span<const Eigen::Vector3d> rest) const {
+    for (const int c : tri)
+        if ((rest[i] - rest[c]).squaredNorm() <= restExclusion2_) return true;
+    return false;
+}
+
+// Every kept triangle within d + skin of particle i and not bonded to it at rest. A particle and
+// the triangles' corners each move less than skin / 2 before the next build, so no triangle
+// left out comes within d before then.
+void Contact::buildList(const SheetState& s) {
+    const int n = int(s.x.size());
+    double widest = 0.0;  // the largest distance from a triangle's centroid to its corners
+    std::vector<Eigen::Vector3d> centres(triangles_.size());
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+        centres[t] = centroid(triangles_[t], s.x);
+        for (const int c : triangles_[t]) widest = std::max(widest, (s.x[c] - centres[t]).norm());
+    }
+    const double reach = thickness_ + skin_;
+    const PointHash hash(centres, reach + widest);
+    const auto candidates = [&](int i, auto&& take) {
+        hash.near(s.x[i], [&](int t) {
+            const auto& tri = triangles_[std::size_t(t)];
+            if (!s.kept.empty() && !s.kept[std::size_t(t)]) return;
+            if ((s.x[i] - centres[std::size_t(t)]).squaredNorm() > std::pow(reach + widest, 2))
+                return;
+            if (bondedAtRest(i, tri, s.rest)) return;
+            const TrianglePoint c =
+                closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+            if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
+                reach * reach)
+                take(t);
+        });
+    };
+    listStart_.assign(std::size_t(n) + 1, 0);
+#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        int count = 0;
+        candidates(i, [&](int) { ++count; });
+        listStart_[std::size_t(i) + 1] = count;
+    }
+    for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
+    list_.resize(std::size_t(listStart_.back()));
+#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        int at = listStart_[std::size_t(i)];
+        candidates(i, [&](int t) { list_[std::size_t(at++)] = t; });
+    }
+    builtAt_.assign(s.x.begin(), s.x.end());
+    ++builds_;
+}
+
+// The force on particle i from the point of triangle `tri` with barycentric weights w: a damped
+// spring over the overlap d - r along the line between them, never pulling, and Coulomb friction
+// on the sliding velocity, at most what stops half of it this step. m_eff = m_i m_t / (m_i + m_t)
+// (m_t the corners' masses by the weights) scales both, so the contact's own frequency is
+// sqrt(stiffnessRate).
+Eigen::Vector3d Contact::contactForce(int i, const std::array<int, 3>& tri,
+                                      const Eigen::Vector3d& w, const Eigen::Vector3d& closest,
+                                      const SheetState& s) const {
+    const Eigen::Vector3d apart = s.x[i] - closest;
+    const double r = apart.norm();
+    if (!(r > 0.0)) return Eigen::Vector3d::Zero();  // on the triangle: no side to push to
+    const Eigen::Vector3d normal = apart / r;
+    const Eigen::Vector3d other = w[0] * s.v[tri[0]] + w[1] * s.v[tri[1]] + w[2] * s.v[tri[2]];
+    const double otherMass = w[0] * s.mass[tri[0]] + w[1] * s.mass[tri[1]] + w[2] * s.mass[tri[2]];
+    const Eigen::Vector3d relative = s.v[i] - other;
+    const double closing = relative.dot(normal);  // > 0: separating
+    const double massEff = s.mass[i] * otherMass / (s.mass[i] + otherMass);
+    const double push =
+        std::max(0.0, massEff * (stiffnessRate_ * (thickness_ - r) - dampingRate_ * closing));
+    Eigen::Vector3d force = push * normal;
+    const Eigen::Vector3d tangential = relative - closing * normal;
+    const double slide = tangential.norm();
+    if (slide > 0.0 && push > 0.0) {
+        const Friction& f = params_.self.friction;
+        const double stop = 0.5 * massEff * slide / s.dt;
+        const double drag = stop <= f.stiction * push ? stop : std::min(stop, f.kinetic * push);
+        force -= (drag / slide) * tangential;
+    }
+    return force;
+}
+
+Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const {
+    PointContact contact;
+    double best = thickness_ * thickness_;
+    Eigen::Vector3d closest;
+    for (int k = listStart_[std::size_t(i)]; k < listStart_[std::size_t(i) + 1]; ++k) {
+        const int t = list_[std::size_t(k)];
+        if (!s.kept.empty() && !s.kept[std::size_t(t)]) continue;  // torn since the build
+        const auto& tri = triangles_[std::size_t(t)];
+        const TrianglePoint c = closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+        const Eigen::Vector3d point = c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+        const double d2 = (s.x[i] - point).squaredNorm();
+        if (d2 >= best) continue;
+        best = d2;
+        contact.triangle = t;
+        contact.weights = c.weights;
+        closest = point;
+    }
+    if (contact.triangle >= 0)
+        contact.force =
+            contactForce(i, triangles_[std::size_t(contact.triangle)], contact.weights, closest, s);
+    return contact;
+}
+
+void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vector3d>& force) {
+    if (listStale(s.x)) buildList(s);
+    const int n = int(s.x.size());
+    double fastest = 0.0;  // squared
+#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) fastest = std::max(fastest, s.v[i].squaredNorm());
+    stiffnessRate_ =
+        std::max(baseStiffnessRate_, kStopping * kStopping * fastest / (thickness_ * thickness_));
+    dampingRate_ = 2.0 * kContactDamping * std::sqrt(stiffnessRate_);
+    contacts_.resize(std::size_t(n));
+    std::size_t pairs = 0;
+#pragma omp parallel for schedule(static) reduction(+ : pairs) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        contacts_[std::size_t(i)] = nearestContact(i, s);
+        if (contacts_[std::size_t(i)].triangle < 0) continue;
+        force[std::size_t(i)] += contacts_[std::size_t(i)].force;
+        ++pairs;
+    }
+    pairs_ = pairs;
+    // The triangles' shares, in particle order: the same sums for any thread count.
+    for (int i = 0; pairs > 0 && i < n; ++i) {
+        const PointContact& c = contacts_[std::size_t(i)];
+        if (c.triangle < 0) continue;
+        const auto& tri = triangles_[std::size_t(c.triangle)];
+        for (int k = 0; k < 3; ++k) force[std::size_t(tri[k])] -= c.weights[k] * c.force;
+    }
+}
+
+}  // namespace rend::sim

@@ -1,0 +1,134 @@
+#pragma once
+// Contact of the membrane with the ground, with kinematic colliders and with itself (issue 13),
+// the same for every solver: Membrane calls it around the solver's forces.
+//
+// - Ground and colliders are kinematic (infinitely heavy): after each drift a particle closer
+//   than half the contact thickness to a surface is moved out to that distance, its approaching
+//   normal velocity relative to the surface is removed, and Coulomb friction acts on the
+//   tangential one with the normal velocity removed as the normal impulse (Bridson, Fedkiw &
+//   Anderson, "Robust treatment of collisions, contact and friction for cloth animation",
+//   SIGGRAPH 2002, Section 7.1). Nothing ends a step inside a collider or below the ground.
+// - Self-contact: a particle repels every kept triangle of the sheet within the contact
+//   thickness d whose corners are not bonded to it at rest (farther than the horizon in the rest
+//   lattice), pushing the triangle's corners back by barycentric shares, so momentum is kept.
+//   Point against triangle, not point against point: particles d = dx / 2 apart would let a
+//   sheet pass between another's particles (a triangle's centre is dx / sqrt(3) from its
+//   corners). A damped penalty force with Coulomb friction acts on the nearest such triangle.
+//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin of d,
+//   rebuilt only once some particle has moved d / 2 since (a Verlet list). The penalty's
+//   stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of sheets
+//   under gravity within d / 4) and grows with the fastest particle's speed, so that no approach
+//   at the scene's speeds closes past d / 2.
+// - The step limit: with self-contact, no two particles close by more than d / 4 in a step
+//   (dt <= d / (4 (2 max|v|))), and no particle moves past half a collider's thinnest part.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "sim/Collider.h"
+#include "sim/ColliderDistance.h"
+
+namespace rend::sim {
+
+class Contact {
+public:
+    /// `thickness`: the contact thickness d (ContactParams' 0 already resolved); `horizon`: the
+    /// rest distance within which two particles are bonded; `stiffnessRate`: the penalty
+    /// stiffness per unit mass at rest [1/s^2].
+    Contact(const ContactParams& params, double thickness, double horizon, double stiffnessRate,
+            std::span<const std::array<int, 3>> triangles);
+
+    double thickness() const { return thickness_; }
+    bool selfContact() const { return params_.self.enabled; }
+    bool hasColliders() const { return params_.ground.enabled || !params_.colliders.empty(); }
+
+    /// Places every collider at time t (its pose and velocity).
+    void place(double t);
+    std::span<const ColliderPose> poses() const { return poses_; }
+    std::span<const ColliderParams> colliders() const { return params_.colliders; }
+
+    /// After a drift to the colliders' current pose: moves the particles for which `free` is
+    /// set out of the ground and the colliders, with friction on their velocities. Records each
+    /// particle's momentum change (lastImpulse).
+    void resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
+                          std::span<const double> mass, std::span<const std::uint8_t> free);
+
+    /// The sheet's state at a force evaluation, as self-contact reads it.
+    struct SheetState {
+        std::span<const Eigen::Vector3d> x, v, rest;
+        std::span<const double> mass;
+        std::span<const std::uint8_t> kept;  ///< per triangle; empty: all kept
+        double dt = 0.0;
+    };
+    /// Adds the self-contact forces to `force`.
+    void addSelfContactForces(const SheetState& sheet, std::vector<Eigen::Vector3d>& force);
+
+    /// The longest step the contact allows with particles moving at most `maxSpeed`.
+    double stepLimit(double maxSpeed) const;
+
+    /// A bound on the work moving colliders did on the sheet since the last call [J]: each
+    /// impulse times the fastest collider point's speed. The blow-up guard's budget takes it.
+    double takeWork() {
+        const double w = work_;
+        work_ = 0.0;
+        return w;
+    }
+    /// The momentum the ground and colliders gave the sheet in the last resolve [N s].
+    Eigen::Vector3d lastImpulse() const;
+    /// Particles touching a triangle within d at the last force evaluation.
+    std::size_t lastPairCount() const { return pairs_; }
+    /// Candidate-list rebuilds so far.
+    long listBuilds() const { return builds_; }
+
+private:
+    /// Moves particle i out of one surface (signed distance `s` at x, outward normal) and applies
+    /// friction against the surface's velocity there.
+    void pushOut(Eigen::Vector3d& x, Eigen::Vector3d& v, const SurfaceDistance& s,
+                 const Eigen::Vector3d& surfaceVelocity, const Friction& friction) const;
+    void resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const;
+    /// One particle's contact with its nearest triangle: the force on the particle, and the
+    /// triangle that takes it back by barycentric shares.
+    struct PointContact {
+        int triangle = -1;
+        Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+        Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    };
+    bool listStale(std::span<const Eigen::Vector3d> x) const;
+    void buildList(const SheetState& s);
+    /// Candidates of particle i within `reach`, appended to out (ascending bucket, triangle).
+    void collectCandidates(int i, const SheetState& s, double reach, std::vector<int>& out) const;
+    bool bondedAtRest(int i, const std::array<int, 3>& tri,
+                      std::span<const Eigen::Vector3d> rest) const;
+    std::uint32_t bucketOf(const Eigen::Vector3i& cell) const;
+    PointContact nearestContact(int i, const SheetState& s) const;
+    Eigen::Vector3d contactForce(int i, const std::array<int, 3>& tri, const Eigen::Vector3d& w,
+                                 const Eigen::Vector3d& closest, const SheetState& s) const;
+
+    ContactParams params_;
+    double thickness_ = 0.0, offset_ = 0.0;  ///< d, and d / 2 off collider surfaces
+    double restExclusion2_ = 0.0;            ///< squared rest distance of bonded neighbours
+    double baseStiffnessRate_ = 0.0;         ///< at rest: holds a pile's weight
+    double stiffnessRate_ = 0.0, dampingRate_ = 0.0;   ///< this evaluation's, from the speeds
+    std::vector<std::optional<MeshDistance>> meshes_;  ///< per collider, for meshes
+    std::vector<ColliderPose> poses_;
+    std::vector<Eigen::Vector3d> impulse_;  ///< per particle, the last resolve's momentum change
+    double work_ = 0.0;                     ///< takeWork's sum
+    /// The fastest collider point at the current poses [m/s].
+    double colliderSpeed() const;
+
+    // Verlet list of candidate triangles per particle (CSR), built from a spatial hash of the
+    // triangles' centroids with cells of twice the search reach.
+    std::vector<std::array<int, 3>> triangles_;
+    double skin_ = 0.0;
+    std::vector<Eigen::Vector3d> builtAt_;  ///< positions at the last build
+    std::vector<int> listStart_, list_;
+    std::vector<PointContact> contacts_;  ///< per particle, this evaluation's
+    std::size_t pairs_ = 0;
+    long builds_ = 0;
+};
+
+}  // namespace rend::sim

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -364,6 +365,13 @@ bool Bsdf::sample(const Vec3& wo, Sampler& rng, Vec3& wi, Vec3& weight, bool& de
 
 // ---- Scene traversal -------------------------------------------------------------------------
 
+/// A collider's triangles and its look's material, which neither the sheet's look layers nor
+/// its colour map touch.
+struct ColliderSurface {
+    const Mesh* mesh = nullptr;
+    Bsdf bsdf;
+};
+
 struct SurfaceHit {
     float t = std::numeric_limits<float>::infinity();
     Vec3 position;
@@ -374,7 +382,8 @@ struct SurfaceHit {
     float transmission = 0.0f;  ///< the look's transmission here (sheet hits only)
     float theta = 0.0f;         ///< the mesh's diffusing quantity, when it has one
     bool ground = false;
-    std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the disc or triangle hit
+    const ColliderSurface* collider = nullptr;     ///< the collider hit, if one was
+    std::uint32_t prim = RTC_INVALID_GEOMETRY_ID;  ///< the sheet's disc or triangle hit
 };
 
 /// Embree hands the context to filter callbacks, so it carries what the disc filter needs.
@@ -439,11 +448,21 @@ Vec3 safeNormalized(const Vec3& v, const Vec3& fallback) {
     return n > 1e-20f && std::isfinite(n) ? Vec3(v / n) : fallback;
 }
 
+/// The normal of a smooth-shaded triangle at Embree's (u, v), which weight vertices 1 and 2.
+Vec3 interpolatedNormal(const Mesh& mesh, const RTCHit& h, const Vec3& fallback) {
+    const auto& tri = mesh.triangles[h.primID];
+    const auto& n = mesh.normals;
+    return safeNormalized((1.0f - h.u - h.v) * n[tri[0]] + h.u * n[tri[1]] + h.v * n[tri[2]],
+                          fallback);
+}
+
 /// What the path tracer needs from the settings, in float, computed once per frame.
 struct Tracer {
     RTCScene scene = nullptr;
     const Mesh* mesh = nullptr;
     const Splats* splats = nullptr;
+    /// By Embree geometry ID: the collider of that ID, or none (mesh null) for the sheet.
+    std::vector<ColliderSurface> colliders;
     Vec3 defaultAlbedo;
     Bsdf material;
     /// Per vertex (mesh) or disc (splats): the look's (GGX alpha, transmission) under its layer;
@@ -498,9 +517,14 @@ struct Tracer {
         return c;
     }
 
+    const ColliderSurface* colliderOf(std::uint32_t geomID) const {
+        return geomID < colliders.size() && colliders[geomID].mesh ? &colliders[geomID] : nullptr;
+    }
+
     bool intersect(const Vec3& origin, const Vec3& direction, std::uint32_t fromPrim,
                    SurfaceHit& hit, long long& rays) const;
     void fillSurface(const RTCHit& h, SurfaceHit& hit) const;
+    void fillCollider(const RTCHit& h, const ColliderSurface& collider, SurfaceHit& hit) const;
     Bsdf bsdfAt(const SurfaceHit& hit) const;
     Vec3 shadowTransmittance(Vec3 origin, const Vec3& direction, std::uint32_t fromPrim,
                              long long& rays) const;
@@ -521,8 +545,7 @@ void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
         // Embree's (u, v) weight vertices 1 and 2 of the triangle.
         const auto& tri = mesh->triangles[h.primID];
         const float w0 = 1.0f - h.u - h.v;
-        const auto& n = mesh->normals;
-        hit.shadingNormal = safeNormalized(w0 * n[tri[0]] + h.u * n[tri[1]] + h.v * n[tri[2]], ng);
+        hit.shadingNormal = interpolatedNormal(*mesh, h, ng);
         const auto& c = mesh->colors;
         hit.albedo =
             c.empty() ? defaultAlbedo : Vec3(w0 * c[tri[0]] + h.u * c[tri[1]] + h.v * c[tri[2]]);
@@ -541,10 +564,20 @@ void Tracer::fillSurface(const RTCHit& h, SurfaceHit& hit) const {
     }
 }
 
-/// The ground is plain Lambert; the sheet is the material with the hit's colour and, where the
-/// look's layer is on, its roughness and transmission.
+/// Theta is 0 on a collider, as on the ground: the EXR's theta layer shows the sheet alone.
+void Tracer::fillCollider(const RTCHit& h, const ColliderSurface& collider, SurfaceHit& hit) const {
+    hit.geometricNormal = safeNormalized(Vec3(h.Ng_x, h.Ng_y, h.Ng_z), Vec3::UnitZ());
+    hit.shadingNormal = interpolatedNormal(*collider.mesh, h, hit.geometricNormal);
+    hit.albedo = collider.bsdf.albedo;
+    hit.theta = 0.0f;
+    hit.collider = &collider;
+}
+
+/// The ground is plain Lambert, a collider its look; the sheet is the material with the hit's
+/// colour and, where the look's layer is on, its roughness and transmission.
 Bsdf Tracer::bsdfAt(const SurfaceHit& hit) const {
     if (hit.ground) return Bsdf{MaterialKind::Diffuse, hit.albedo};
+    if (hit.collider) return hit.collider->bsdf;
     Bsdf bsdf = material;
     bsdf.albedo = hit.albedo;
     if (layerParams.empty()) return bsdf;
@@ -560,7 +593,10 @@ bool Tracer::intersect(const Vec3& origin, const Vec3& direction, std::uint32_t 
     TraceContext c = context(fromPrim);
     rtcIntersect1(scene, &c.embree, &rh);
     ++rays;
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+    if (const ColliderSurface* collider = colliderOf(rh.hit.geomID)) {
+        hit.t = rh.ray.tfar;
+        fillCollider(rh.hit, *collider, hit);
+    } else if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
         hit.t = rh.ray.tfar;
         fillSurface(rh.hit, hit);
         hit.ground = false;
@@ -714,13 +750,17 @@ void checkGeometry(const Splats& splats) {
         throw std::invalid_argument("EmbreeRenderer: splat attribute arrays differ in length");
 }
 
-/// Largest absolute coordinate of the geometry and the camera: the scale of float round-off.
-float sceneScale(const Geometry& geometry, const RenderSettings& s) {
+/// Largest absolute coordinate of the geometry, the colliders and the camera: the scale of
+/// float round-off.
+float sceneScale(const Geometry& geometry, std::span<const Mesh> colliders,
+                 const RenderSettings& s) {
     float scale = std::max(1.0f, float(s.camera.position.cwiseAbs().maxCoeff()));
     const auto& points = std::holds_alternative<Mesh>(geometry)
                              ? std::get<Mesh>(geometry).positions
                              : std::get<Splats>(geometry).centers;
     for (const Vec3& p : points) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+    for (const Mesh& collider : colliders)
+        for (const Vec3& p : collider.positions) scale = std::max(scale, p.cwiseAbs().maxCoeff());
     return scale;
 }
 
@@ -741,7 +781,28 @@ std::vector<std::array<float, 2>> layerParams(const Geometry& geometry, const Re
     return params;
 }
 
-Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
+Bsdf colliderBsdf(const ColliderLook& look) {
+    const Vec3 color = toFloat(look.color).cwiseMax(0.0f).cwiseMin(1.0f);
+    if (!look.metal) return Bsdf{MaterialKind::Diffuse, color};
+    return Bsdf{MaterialKind::Conductor, color, ggxAlpha(look.roughness)};
+}
+
+/// `geometryOf[c]`: the Embree geometry ID of collider c, or RTC_INVALID_GEOMETRY_ID when it has
+/// no triangles.
+std::vector<ColliderSurface> colliderSurfaces(std::span<const Mesh> colliders,
+                                              std::span<const std::uint32_t> geometryOf,
+                                              const RenderSettings& s) {
+    std::vector<ColliderSurface> byGeometry;
+    for (std::size_t c = 0; c < colliders.size(); ++c) {
+        if (geometryOf[c] == RTC_INVALID_GEOMETRY_ID) continue;
+        if (byGeometry.size() <= geometryOf[c]) byGeometry.resize(geometryOf[c] + 1);
+        byGeometry[geometryOf[c]] = {&colliders[c], colliderBsdf(s.colliderLook(c))};
+    }
+    return byGeometry;
+}
+
+Tracer makeTracer(const Geometry& geometry, std::span<const Mesh> colliders,
+                  const RenderSettings& s) {
     const PathTracing& pt = s.pathTracing;
     Tracer tr;
     tr.defaultAlbedo = toFloat(s.albedo);
@@ -752,7 +813,7 @@ Tracer makeTracer(const Geometry& geometry, const RenderSettings& s) {
     tr.tone = s.tone;
     tr.maxDepth = std::max(1, pt.maxDepth);
     tr.seedKey = std::uint64_t(pt.seed) << 40;  // images have fewer than 2^40 pixels
-    tr.epsilon = 1e-4f * sceneScale(geometry, s);
+    tr.epsilon = 1e-4f * sceneScale(geometry, colliders, s);
     tr.ground = s.ground;
     tr.groundZ = float(s.groundHeight);
     tr.groundColor = toFloat(s.groundColor);
@@ -817,7 +878,8 @@ void storeLayers(const SurfaceHit* hit, std::size_t pixel, FrameLayers& layers) 
     }
     layers.depth[pixel] = hit->t;
     for (int k = 0; k < 3; ++k) layers.normal[pixel * 3 + k] = hit->shadingNormal[k];
-    if (!layers.theta.empty()) layers.theta[pixel] = hit->ground ? 0.0f : hit->theta;
+    if (!layers.theta.empty())
+        layers.theta[pixel] = hit->ground || hit->collider ? 0.0f : hit->theta;
 }
 
 void storeGuides(const SurfaceHit* hit, std::size_t pixel, float variance, DenoiseGuides& g) {
@@ -847,6 +909,15 @@ void sizeGuides(const CameraRays& camera, DenoiseGuides& g) {
 struct EmbreeRenderer::Impl {
     enum class Kind { None, Mesh, Splats };
 
+    /// One collider's triangle geometry in the scene, kept to refit it while its topology holds.
+    struct ColliderGeometry {
+        std::uint32_t id = RTC_INVALID_GEOMETRY_ID;  ///< invalid: the collider has no triangles
+        RTCGeometry geometry = nullptr;
+        float* vertices = nullptr;
+        std::size_t vertexCount = 0;
+        std::vector<std::array<std::uint32_t, 3>> triangles;
+    };
+
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     RTCGeometry geometry = nullptr;  ///< owned by the scene; kept to update its buffers
@@ -855,6 +926,7 @@ struct EmbreeRenderer::Impl {
     std::vector<std::array<std::uint32_t, 3>> triangles;  ///< the last frame's topology
     float* vertices = nullptr;                            ///< Embree-owned buffers of `geometry`
     float* normals = nullptr;
+    std::vector<ColliderGeometry> colliders;  ///< index for index with the frame's colliders
     std::string lastError;
     long long rays = 0;
     // Per-frame buffers, kept so that a 1080p frame does not fault in 100 MB of fresh pages.
@@ -865,13 +937,17 @@ struct EmbreeRenderer::Impl {
 
     ~Impl();
     void check(const char* what);
-    void upload(const Geometry& geometry);
+    void upload(const Geometry& geometry, std::span<const Mesh> colliderMeshes);
     bool sameTopology(const Geometry& geometry) const;
+    bool sameColliders(std::span<const Mesh> colliderMeshes) const;
     void rebuild(const Geometry& geometry);
     void createMesh(const Mesh& mesh);
     void createSplats(const Splats& splats);
     void copyVertices(const Geometry& geometry);
     void refit();
+    void syncColliders(std::span<const Mesh> colliderMeshes);
+    ColliderGeometry createCollider(const Mesh& mesh);
+    std::vector<std::uint32_t> colliderIds() const;
     Image trace(const Tracer& tracer, const CameraRays& camera, int spp, bool denoised,
                 FrameLayers* layers);
     Vec3 samplePixel(const Tracer& tracer, const CameraRays& camera, int spp, int x, int y,
@@ -898,17 +974,32 @@ bool EmbreeRenderer::Impl::sameTopology(const Geometry& g) const {
     return kind == Kind::Splats && std::get<Splats>(g).centers.size() == vertexCount;
 }
 
-void EmbreeRenderer::Impl::upload(const Geometry& g) {
+bool EmbreeRenderer::Impl::sameColliders(std::span<const Mesh> meshes) const {
+    if (meshes.size() != colliders.size()) return false;
+    for (std::size_t c = 0; c < meshes.size(); ++c)
+        if (meshes[c].positions.size() != colliders[c].vertexCount ||
+            meshes[c].triangles != colliders[c].triangles)
+            return false;
+    return true;
+}
+
+/// The sheet and the colliders are refitted while their topology holds; the scene is committed
+/// once, after both.
+void EmbreeRenderer::Impl::upload(const Geometry& g, std::span<const Mesh> colliderMeshes) {
     if (geometry && sameTopology(g)) {
         copyVertices(g);
         refit();
     } else {
         rebuild(g);
     }
+    syncColliders(colliderMeshes);
+    rtcCommitScene(scene);
+    check("building the BVH");
 }
 
 void EmbreeRenderer::Impl::rebuild(const Geometry& g) {
     if (scene) rtcReleaseScene(scene);
+    colliders.clear();  // released with the scene
     geometry = nullptr;
     kind = Kind::None;
     vertexCount = 0;
@@ -923,8 +1014,6 @@ void EmbreeRenderer::Impl::rebuild(const Geometry& g) {
     } else if (!std::get<Splats>(g).centers.empty()) {
         createSplats(std::get<Splats>(g));
     }
-    rtcCommitScene(scene);
-    check("building the BVH");
 }
 
 void EmbreeRenderer::Impl::createMesh(const Mesh& mesh) {
@@ -991,8 +1080,53 @@ void EmbreeRenderer::Impl::refit() {
     // Same topology: moving the existing BVH's boxes is far cheaper than a rebuild.
     rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
     rtcCommitGeometry(geometry);
-    rtcCommitScene(scene);
-    check("refitting the BVH");
+}
+
+/// Colliders move every frame but rarely change shape: the same triangles refit, others replace
+/// every collider geometry.
+void EmbreeRenderer::Impl::syncColliders(std::span<const Mesh> meshes) {
+    if (sameColliders(meshes)) {
+        for (std::size_t c = 0; c < meshes.size(); ++c) {
+            if (!colliders[c].geometry) continue;
+            std::memcpy(colliders[c].vertices, meshes[c].positions.data(),
+                        meshes[c].positions.size() * sizeof(Vec3));
+            rtcUpdateGeometryBuffer(colliders[c].geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+            rtcSetGeometryBuildQuality(colliders[c].geometry, RTC_BUILD_QUALITY_REFIT);
+            rtcCommitGeometry(colliders[c].geometry);
+        }
+        return;
+    }
+    for (const ColliderGeometry& c : colliders)
+        if (c.geometry) rtcDetachGeometry(scene, c.id);
+    colliders.clear();
+    for (const Mesh& mesh : meshes) colliders.push_back(createCollider(mesh));
+}
+
+EmbreeRenderer::Impl::ColliderGeometry EmbreeRenderer::Impl::createCollider(const Mesh& mesh) {
+    ColliderGeometry c;
+    c.vertexCount = mesh.positions.size();
+    c.triangles = mesh.triangles;
+    if (mesh.triangles.empty()) return c;
+    c.geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    check("creating a collider's triangle geometry");
+    c.vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        c.geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3), c.vertexCount));
+    auto* index = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(c.geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(std::uint32_t), mesh.triangles.size()));
+    check("allocating a collider's triangle buffers");
+    std::memcpy(index, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(std::uint32_t));
+    std::memcpy(c.vertices, mesh.positions.data(), c.vertexCount * sizeof(Vec3));
+    rtcCommitGeometry(c.geometry);
+    c.id = rtcAttachGeometry(scene, c.geometry);
+    rtcReleaseGeometry(c.geometry);  // the scene holds the reference now
+    return c;
+}
+
+std::vector<std::uint32_t> EmbreeRenderer::Impl::colliderIds() const {
+    std::vector<std::uint32_t> ids;
+    for (const ColliderGeometry& c : colliders) ids.push_back(c.id);
+    return ids;
 }
 
 namespace {
@@ -1096,12 +1230,14 @@ EmbreeRenderer::EmbreeRenderer() : impl_(std::make_unique<Impl>()) {
 EmbreeRenderer::~EmbreeRenderer() = default;
 
 Image EmbreeRenderer::render(const Geometry& geometry, const RenderSettings& settings,
-                             FrameLayers* layers) {
+                             FrameLayers* layers, std::span<const Mesh> colliders) {
     if (settings.width <= 0 || settings.height <= 0)
         throw std::invalid_argument("EmbreeRenderer: image size must be positive");
     std::visit([](const auto& g) { checkGeometry(g); }, geometry);
-    impl_->upload(geometry);
-    Tracer tracer = makeTracer(geometry, settings);
+    for (const Mesh& collider : colliders) checkMesh(collider, "EmbreeRenderer (a collider)");
+    impl_->upload(geometry, colliders);
+    Tracer tracer = makeTracer(geometry, colliders, settings);
+    tracer.colliders = colliderSurfaces(colliders, impl_->colliderIds(), settings);
     tracer.scene = impl_->scene;
     const CameraRays camera(settings);
     const int spp = std::max(1, settings.pathTracing.samplesPerPixel);

@@ -7,6 +7,7 @@
 // bytes.
 
 #include <memory>
+#include <span>
 #include <string>
 
 #include "render/ExrWriter.h"
@@ -27,9 +28,11 @@ public:
     /// kind, same triangle indices or disc count) only refits the BVH. Throws
     /// std::invalid_argument for inconsistent geometry or a non-positive image size. With
     /// `layers`, also fills its linear radiance and the first-hit depth, normal and theta of
-    /// each pixel's centre ray (for writeExrAtomic).
+    /// each pixel's centre ray (for writeExrAtomic). `colliders`: world-space meshes
+    /// (colliderMeshes in render/ColliderMesh.h), index for index with
+    /// RenderSettings::colliderLooks; they cast and receive shadows, and their theta is 0.
     Image render(const Geometry& geometry, const RenderSettings& settings,
-                 FrameLayers* layers = nullptr);
+                 FrameLayers* layers = nullptr, std::span<const Mesh> colliders = {});
 
     /// The Embree version actually loaded, e.g. "Embree 3.13.5".
     std::string deviceDescription();

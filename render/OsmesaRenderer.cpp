@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -215,6 +216,33 @@ void drawHighlights(const Mesh& mesh, const VertexShading& shading) {
     glDisable(GL_BLEND);
 }
 
+/// A collider's look as the sheet's shading would give it: Lambert, or a metal with the same
+/// stand-in diffuse and normalised lobe as a metal sheet.
+VertexShading colliderShading(const Mesh& mesh, const ColliderLook& look) {
+    const Eigen::Vector3f color = look.color.cast<float>().cwiseMax(0.0f).cwiseMin(1.0f);
+    const float exponent = phongExponent(float(look.roughness));
+    const float peak = (exponent + 8.0f) / (8.0f * std::numbers::pi_v<float>);
+    const std::size_t n = mesh.positions.size();
+    VertexShading out;
+    out.diffuse.assign(n, look.metal ? Eigen::Vector3f(kMetalDiffuse * color) : color);
+    out.specular.assign(n, (peak / float(kHeadroom)) * color);
+    out.shininess = exponent;
+    out.glossy = look.metal;
+    return out;
+}
+
+void drawColliders(std::span<const Mesh> colliders, const RenderSettings& s) {
+    for (std::size_t c = 0; c < colliders.size(); ++c) {
+        if (colliders[c].triangles.empty()) continue;
+        const VertexShading shading = colliderShading(colliders[c], s.colliderLook(c));
+        drawTriangles(colliders[c], shading.diffuse);
+        if (!shading.glossy) continue;
+        drawHighlights(colliders[c], shading);
+        setupLighting(s);  // the highlight pass changed the material and the fog colour
+        setupFog(s);
+    }
+}
+
 void drawMesh(const Mesh& mesh, const RenderSettings& s) {
     if (mesh.triangles.empty()) return;
     const VertexShading shading = vertexShading(mesh, s);
@@ -289,10 +317,12 @@ OsmesaRenderer::~OsmesaRenderer() {
     if (impl_ && impl_->context) OSMesaDestroyContext(impl_->context);
 }
 
-Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings) {
+Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings,
+                             std::span<const Mesh> colliders) {
     if (settings.width <= 0 || settings.height <= 0)
         throw std::invalid_argument("OsmesaRenderer: image size must be positive");
     checkMesh(mesh, "OsmesaRenderer");
+    for (const Mesh& collider : colliders) checkMesh(collider, "OsmesaRenderer (a collider)");
     const int ss = std::max(1, settings.supersample);
     const int w = settings.width * ss;
     const int h = settings.height * ss;
@@ -308,6 +338,7 @@ Image OsmesaRenderer::render(const Mesh& mesh, const RenderSettings& settings) {
     setupLighting(settings);
     setupFog(settings);
     if (settings.ground) drawGround(settings);
+    drawColliders(colliders, settings);
     drawMesh(mesh, settings);
     glFinish();
     return impl_->resolve(settings.width, settings.height, ss, settings.tone);

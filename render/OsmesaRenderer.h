@@ -3,6 +3,7 @@
 // light plus ambient, two-sided shading, a ground plane.
 
 #include <memory>
+#include <span>
 #include <string>
 
 #include "render/Image.h"
@@ -18,7 +19,10 @@ public:
     OsmesaRenderer(const OsmesaRenderer&) = delete;
     OsmesaRenderer& operator=(const OsmesaRenderer&) = delete;
 
-    Image render(const Mesh& mesh, const RenderSettings& settings);
+    /// `colliders`: world-space meshes (colliderMeshes in render/ColliderMesh.h), index for index
+    /// with RenderSettings::colliderLooks, shaded in their looks' colours.
+    Image render(const Mesh& mesh, const RenderSettings& settings,
+                 std::span<const Mesh> colliders = {});
 
     /// GL_RENDERER and GL_VERSION of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5".
     std::string glDescription();

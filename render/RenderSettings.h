@@ -3,8 +3,10 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 namespace rend::render {
 
@@ -78,6 +80,15 @@ struct VdbSettings {
     double adaptivity = 0.1;      ///< volumeToMesh adaptivity in [0, 1]
 };
 
+/// How a collider (sim/Collider.h) is drawn: Lambert in `color`, or, when `metal`, a rough
+/// conductor whose reflectance at normal incidence is `color`. The default is a neutral warm grey,
+/// darker than the default sheet's albedo so a pale sheet stays visible against it.
+struct ColliderLook {
+    Eigen::Vector3d color{0.62, 0.60, 0.56};
+    double roughness = 0.6;  ///< GGX alpha = roughness^2, as the sheet's
+    bool metal = false;
+};
+
 struct RenderSettings {
     int width = 960;
     int height = 540;
@@ -99,6 +110,12 @@ struct RenderSettings {
     double thickness = 0.0;  ///< lattice surface extruded to this thickness [m]; 0: a sheet
     PathTracing pathTracing;
     VdbSettings vdb;
+    /// Index for index with FrameView::colliders; a collider past the end has the default look.
+    std::vector<ColliderLook> colliderLooks;
+
+    ColliderLook colliderLook(std::size_t collider) const {
+        return collider < colliderLooks.size() ? colliderLooks[collider] : ColliderLook{};
+    }
 };
 
 }  // namespace rend::render

@@ -65,7 +65,9 @@ struct Sheet {
                 .bondRestLength = restLength,
                 .bondAlive = alive,
                 .keptTriangles = kept,
-                .triangleAlive = {}};
+                .triangleAlive = {},
+                .colliders = {},
+                .colliderPoses = {}};
     }
 
     /// Breaks the bond a-b from both ends, and drops the triangles along it as the

@@ -5,6 +5,7 @@
 
 #include "app/Pipeline.h"
 #include "app/SceneError.h"
+#include "render/ColliderMesh.h"
 #include "render/EmbreeRenderer.h"
 #include "render/ExrWriter.h"
 #include "render/LatticeSurface.h"
@@ -100,16 +101,17 @@ bool FrameWriter::writesExr() const {
     return scene_.writeExr && scene_.renderer == RendererKind::Embree;
 }
 
-render::Image FrameWriter::renderImage(const render::Geometry& geometry,
+render::Image FrameWriter::renderImage(const sim::FrameView& view, const render::Geometry& geometry,
                                        render::FrameLayers* layers) {
     Parts& p = *parts_;
+    const std::vector<render::Mesh> colliders = render::colliderMeshes(view);
     if (scene_.renderer == RendererKind::Embree) {
         if (!p.embree) p.embree = std::make_unique<render::EmbreeRenderer>();
-        return p.embree->render(geometry, scene_.render, layers);
+        return p.embree->render(geometry, scene_.render, layers, colliders);
     }
     if (!p.osmesa) p.osmesa = std::make_unique<render::OsmesaRenderer>();
     render::Mesh scratch;
-    return p.osmesa->render(asMesh(geometry, scratch), scene_.render);
+    return p.osmesa->render(asMesh(geometry, scratch), scene_.render, colliders);
 }
 
 void FrameWriter::exportFrame(const sim::FrameView& view, const render::Geometry& geometry,
@@ -145,7 +147,7 @@ void FrameWriter::write(const sim::FrameView& view, StageTimes& seconds,
     if (scene_.renderer != RendererKind::None) {
         t0 = Clock::now();
         render::FrameLayers layers;
-        const render::Image image = renderImage(geometry, writesExr() ? &layers : nullptr);
+        const render::Image image = renderImage(view, geometry, writesExr() ? &layers : nullptr);
         seconds.render += secondsSince(t0);
         t0 = Clock::now();
         std::filesystem::create_directories(outDir_ / "frames");

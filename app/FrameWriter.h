@@ -39,7 +39,8 @@ private:
     render::Geometry buildSurface(const sim::FrameView& view);
     bool writesExr() const;  ///< [output] exr with the path tracer
     /// The frame's PNG image; with the path tracer also its EXR layers when `layers` is given.
-    render::Image renderImage(const render::Geometry& geometry, render::FrameLayers* layers);
+    render::Image renderImage(const sim::FrameView& view, const render::Geometry& geometry,
+                              render::FrameLayers* layers);
     void exportFrame(const sim::FrameView& view, const render::Geometry& geometry,
                      std::vector<std::string>& written);
 

@@ -185,8 +185,9 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"frames_written\": " << s.framesWritten << ",\n"
       << "  \"threads\": " << omp_get_max_threads() << ",\n"
       << "  \"wall_seconds\": {\"setup\": " << s.seconds.setup
-      << ", \"simulate\": " << s.seconds.simulate << ", \"surface\": " << s.seconds.surface
-      << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write << "},\n"
+      << ", \"simulate\": " << s.seconds.simulate << ", \"contact\": " << s.seconds.contact
+      << ", \"surface\": " << s.seconds.surface << ", \"render\": " << s.seconds.render
+      << ", \"write\": " << s.seconds.write << "},\n"
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
       << "  \"state_hash\": " << jsonString(hash) << ",\n"
       << "  \"files\": " << jsonStringArray(files, "  ") << ",\n"
@@ -357,6 +358,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     auto finish = [&](const std::string& status) {
         s.steps = membrane.stepCount();
         s.extraSubsteps = membrane.extraSubsteps();
+        s.seconds.contact = membrane.contactSeconds();
         if (adaptive && s.steps > 0) {
             s.dt = membrane.time() / double(s.steps);
             s.dtMin = membrane.smallestTimeStep();

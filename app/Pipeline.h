@@ -23,6 +23,7 @@ struct RunOptions {
 struct StageTimes {
     double setup = 0.0;
     double simulate = 0.0;
+    double contact = 0.0;  ///< of simulate: ground, colliders and self-contact
     double surface = 0.0;
     double render = 0.0;
     double write = 0.0;

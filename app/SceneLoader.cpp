@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "app/ContactLoader.h"
 #include "app/Scene.h"
 #include "app/SceneDocument.h"
 #include "app/SceneError.h"
@@ -706,6 +707,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     s.render.camera = readCamera(root, s.sim.sheet);
     readLight(root, s.render);
     readRender(root, s.sim.sheet, s);
+    readContact(root, s);
     readOutput(root, s);
     log.reportUnused();
     s.locations = log.locations();

@@ -10,6 +10,8 @@
 namespace rend::names {
 
 inline constexpr std::string_view kShapes[] = {"rectangle", "disc", "sphere"};  // sim::Outline
+inline constexpr std::string_view kColliderShapes[] = {"sphere", "box", "capsule",
+                                                       "mesh"};  // sim::ColliderShape
 inline constexpr std::string_view kLattices[] = {"hexagonal", "square"};
 inline constexpr std::string_view kQualities[] = {"preview", "final"};  // rend::Quality
 inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};

@@ -31,7 +31,7 @@ folder = pathlib.Path(sys.argv[1])
 run = json.loads((folder / "run.json").read_text())
 broken = list(csv.DictReader(open(folder / "stats.csv")))[-1]["broken_bonds"]
 wall = run["wall_seconds"]
-stages = " ".join(f"{k} {wall[k]:.1f}" for k in ("simulate", "surface", "render"))
+stages = " ".join(f"{k} {wall.get(k, 0):.1f}" for k in ("simulate", "contact", "surface", "render"))
 print(f"{sys.argv[2]}: {run['particles']} particles, {run['steps']} steps, "
       f"{broken} broken bonds, {stages} s")
 PY

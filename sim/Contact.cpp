@@ -1,5 +1,7 @@
 #include "sim/Contact.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -20,18 +22,23 @@ constexpr double kStepFraction = 0.25;
 /// frequency stays at sqrt(rate) dt <= kStopping kStepFraction / 2 = 0.625.
 constexpr double kStopping = 5.0;
 
+Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
+    return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
+}
+
 }  // namespace
 
 Contact::Contact(const ContactParams& params, double thickness, double horizon,
-                 double stiffnessRate, std::span<const std::array<int, 3>> triangles)
+                 double stiffnessRate, std::span<const std::array<int, 3>> triangles,
+                 std::span<const Eigen::Vector3d> rest)
     : params_(params),
       thickness_(thickness),
       offset_(0.5 * thickness),
       baseStiffnessRate_(stiffnessRate) {
     const double reach = horizon * (1.0 + 1e-9);  // the bond families' own reach (Bonds.cpp)
     restExclusion2_ = reach * reach;
-    skin_ = thickness_;
-    if (params_.self.enabled) triangles_.assign(triangles.begin(), triangles.end());
+    skin_ = 1.5 * thickness_;
+    if (params_.self.enabled) setUpTriangles(triangles, rest, reach);
     meshes_.resize(params_.colliders.size());
     for (std::size_t c = 0; c < params_.colliders.size(); ++c) {
         const ColliderParams& collider = params_.colliders[c];
@@ -40,6 +47,20 @@ Contact::Contact(const ContactParams& params, double thickness, double horizon,
             meshes_[c].emplace(*collider.mesh, 4.0 * thickness_);
     }
     place(0.0);
+}
+
+void Contact::setUpTriangles(std::span<const std::array<int, 3>> triangles,
+                             std::span<const Eigen::Vector3d> rest, double reach) {
+    triangles_.assign(triangles.begin(), triangles.end());
+    double widest = 0.0;
+    restCentres_.resize(triangles_.size());
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+        restCentres_[t] = centroid(triangles_[t], rest);
+        for (const int c : triangles_[t])
+            widest = std::max(widest, (rest[c] - restCentres_[t]).norm());
+    }
+    allBonded2_ = reach > widest ? (reach - widest) * (reach - widest) : -1.0;
+    noneBonded2_ = (reach + widest) * (reach + widest);
 }
 
 void Contact::place(double t) {
@@ -132,49 +153,44 @@ double Contact::stepLimit(double maxSpeed) const {
 
 namespace {
 
-/// Sorts the first `count` buckets and drops repeats (two cells may share a bucket); returns how
-/// many are left. Insertion sort: at most eight.
-int sortUnique(std::array<std::uint32_t, 8>& b, int count) {
-    for (int k = 1; k < count; ++k)
-        for (int j = k; j > 0 && b[j - 1] > b[j]; --j) std::swap(b[j - 1], b[j]);
-    int kept = 0;
-    for (int k = 0; k < count; ++k)
-        if (kept == 0 || b[kept - 1] != b[k]) b[kept++] = b[k];
-    return kept;
-}
-
-/// A spatial hash of points: cells of size 2 r, so the cube of half-width r about a query meets
-/// at most two cells along each axis; the items counting-sorted by bucket, ascending within one.
 class PointHash {
 public:
-    PointHash(std::span<const Eigen::Vector3d> points, double radius)
-        : radius_(radius), cell_(2.0 * radius) {
+    PointHash(std::span<const Eigen::Vector3d> points, double radius) : cell_(radius) {
         const std::size_t n = points.size();
         std::uint32_t buckets = 1;
         while (buckets < 2 * n) buckets <<= 1;
         mask_ = buckets - 1;
         std::vector<std::uint32_t> bucket(n);
-        for (std::size_t i = 0; i < n; ++i) bucket[i] = bucketOf(cellOf(points[i]));
+        std::vector<Eigen::Vector3i> cell(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            cell[i] = cellOf(points[i]);
+            bucket[i] = bucketOf(cell[i]);
+        }
         start_.assign(std::size_t(buckets) + 1, 0);
         for (std::size_t i = 0; i < n; ++i) ++start_[bucket[i] + 1];
         for (std::uint32_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
         items_.resize(n);
+        cells_.resize(n);
         std::vector<int> fill(start_.begin(), start_.end() - 1);
-        for (std::size_t i = 0; i < n; ++i) items_[std::size_t(fill[bucket[i]]++)] = int(i);
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t at = std::size_t(fill[bucket[i]]++);
+            items_[at] = int(i);
+            cells_[at] = cell[i];
+        }
     }
 
-    /// Calls f(item) for every item in the buckets near x (a superset of those within r).
+    /// Calls f(item) for every item in the 27 cells about x (a superset of those within r).
     template <class F>
     void near(const Eigen::Vector3d& x, F&& f) const {
-        std::array<std::uint32_t, 8> found{};
-        const Eigen::Vector3i lo = cellOf(x.array() - radius_), hi = cellOf(x.array() + radius_);
-        int count = 0;
-        for (int z = lo.z(); z <= hi.z(); ++z)
-            for (int y = lo.y(); y <= hi.y(); ++y)
-                for (int c = lo.x(); c <= hi.x(); ++c) found[count++] = bucketOf({c, y, z});
-        count = sortUnique(found, count);
-        for (int k = 0; k < count; ++k)
-            for (int s = start_[found[k]]; s < start_[found[k] + 1]; ++s) f(items_[std::size_t(s)]);
+        const Eigen::Vector3i c = cellOf(x);
+        for (int z = -1; z <= 1; ++z)
+            for (int y = -1; y <= 1; ++y)
+                for (int w = -1; w <= 1; ++w) {
+                    const Eigen::Vector3i cell = c + Eigen::Vector3i(w, y, z);
+                    const std::uint32_t b = bucketOf(cell);
+                    for (int s = start_[b]; s < start_[b + 1]; ++s)
+                        if (cells_[std::size_t(s)] == cell) f(items_[std::size_t(s)]);
+                }
     }
 
 private:
@@ -188,24 +204,27 @@ private:
         return std::uint32_t(h ^ (h >> 32)) & mask_;
     }
 
-    double radius_, cell_;
+    double cell_;
     std::uint32_t mask_ = 0;
     std::vector<int> start_, items_;
+    std::vector<Eigen::Vector3i> cells_;
 };
-
-Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
-    return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
-}
 
 }  // namespace
 
+// A common translation changes no distance, so the list goes stale only once two particles may
+// have closed by the skin: some particle has moved more than skin / 2 relative to the mean
+// displacement (a falling sheet keeps its list).
 bool Contact::listStale(std::span<const Eigen::Vector3d> x) const {
     if (builtAt_.size() != x.size()) return true;
     const int n = int(x.size());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // in particle order: the same bits always
+    for (int i = 0; i < n; ++i) mean += x[i] - builtAt_[i];
+    mean /= n;
     const double limit = 0.25 * skin_ * skin_;  // (skin / 2)^2
     double moved = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : moved) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i]).squaredNorm());
+    for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i] - mean).squaredNorm());
     return moved > limit;
 }
 
@@ -216,47 +235,72 @@ bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
     return false;
 }
 
-// Every kept triangle within d + skin of particle i and not bonded to it at rest. A particle and
+// Every kept triangle within d + skin of particle i and not bonded to it at rest, and every
+// particle within d + skin not bonded to it at rest. A particle and
 // the triangles' corners each move less than skin / 2 before the next build, so no triangle
-// left out comes within d before then.
+// left out comes within d before then. Each thread lists a contiguous range of particles, in
+// order, so the lists do not depend on the thread count.
 void Contact::buildList(const SheetState& s) {
     const int n = int(s.x.size());
-    double widest = 0.0;  // the largest distance from a triangle's centroid to its corners
-    std::vector<Eigen::Vector3d> centres(triangles_.size());
+    // The kept triangles (torn ones are never touched) and the largest distance from one's
+    // centroid to its corners.
+    double widest = 0.0;
+    std::vector<int> kept;
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<double> radii;  // each triangle's own
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
-        centres[t] = centroid(triangles_[t], s.x);
-        for (const int c : triangles_[t]) widest = std::max(widest, (s.x[c] - centres[t]).norm());
+        if (!s.kept.empty() && !s.kept[t]) continue;
+        kept.push_back(int(t));
+        centres.push_back(centroid(triangles_[t], s.x));
+        double r = 0.0;
+        for (const int c : triangles_[t]) r = std::max(r, (s.x[c] - centres.back()).norm());
+        radii.push_back(r);
+        widest = std::max(widest, r);
     }
-    const double reach = thickness_ + skin_;
-    const PointHash hash(centres, reach + widest);
-    const auto candidates = [&](int i, auto&& take) {
-        hash.near(s.x[i], [&](int t) {
+    const double reach = thickness_ + skin_, search = reach + widest;
+    const PointHash hash(centres, search);
+    const PointHash points(s.x, reach);
+    const auto triangleCandidates = [&](int i, std::vector<std::pair<int, int>>& out) {
+        hash.near(s.x[i], [&](int k) {
+            const int t = kept[std::size_t(k)];
             const auto& tri = triangles_[std::size_t(t)];
-            if (!s.kept.empty() && !s.kept[std::size_t(t)]) return;
-            if ((s.x[i] - centres[std::size_t(t)]).squaredNorm() > std::pow(reach + widest, 2))
-                return;
-            if (bondedAtRest(i, tri, s.rest)) return;
+            const double near = reach + radii[std::size_t(k)];  // a bound on its distance
+            if ((s.x[i] - centres[std::size_t(k)]).squaredNorm() >= near * near) return;
+            const double fromRest = (s.rest[i] - restCentres_[std::size_t(t)]).squaredNorm();
+            if (fromRest <= allBonded2_) return;  // every corner within the horizon
+            if (fromRest <= noneBonded2_ && bondedAtRest(i, tri, s.rest)) return;
             const TrianglePoint c =
                 closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
             if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
                 reach * reach)
-                take(t);
+                out.emplace_back(i, t);
         });
     };
+    const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
+        triangleCandidates(i, out);
+        points.near(s.x[i], [&](int j) {
+            if (j == i || (s.x[i] - s.x[j]).squaredNorm() >= reach * reach) return;
+            if ((s.rest[i] - s.rest[j]).squaredNorm() <= restExclusion2_) return;
+            out.emplace_back(i, -(j + 1));  // a particle: negative
+        });
+    };
+    std::vector<std::vector<std::pair<int, int>>> found;
+#pragma omp parallel if (n >= kParallelThreshold)
+    {
+#pragma omp single
+        found.resize(std::size_t(omp_get_num_threads()));
+        std::vector<std::pair<int, int>>& mine = found[std::size_t(omp_get_thread_num())];
+#pragma omp for schedule(static)
+        for (int i = 0; i < n; ++i) candidates(i, mine);
+    }
     listStart_.assign(std::size_t(n) + 1, 0);
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        int count = 0;
-        candidates(i, [&](int) { ++count; });
-        listStart_[std::size_t(i) + 1] = count;
-    }
+    list_.clear();
+    for (const auto& part : found)  // thread order is particle order
+        for (const auto& [i, t] : part) {
+            ++listStart_[std::size_t(i) + 1];
+            list_.push_back(t);
+        }
     for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
-    list_.resize(std::size_t(listStart_.back()));
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        int at = listStart_[std::size_t(i)];
-        candidates(i, [&](int t) { list_[std::size_t(at++)] = t; });
-    }
     builtAt_.assign(s.x.begin(), s.x.end());
     ++builds_;
 }
@@ -292,12 +336,22 @@ Eigen::Vector3d Contact::contactForce(int i, const std::array<int, 3>& tri,
     return force;
 }
 
+// Particle i against its list: the nearest triangle within d, whose corners take the force back
+// (scattered later), and every particle within d, whose own list holds i and computes the
+// opposite force with the same arithmetic (gathered here).
 Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const {
     PointContact contact;
     double best = thickness_ * thickness_;
     Eigen::Vector3d closest;
     for (int k = listStart_[std::size_t(i)]; k < listStart_[std::size_t(i) + 1]; ++k) {
         const int t = list_[std::size_t(k)];
+        if (t < 0) {
+            const int j = -t - 1;
+            if ((s.x[i] - s.x[j]).squaredNorm() >= thickness_ * thickness_) continue;
+            contact.pointForce += contactForce(i, {j, j, j}, Eigen::Vector3d(1, 0, 0), s.x[j], s);
+            ++contact.points;
+            continue;
+        }
         if (!s.kept.empty() && !s.kept[std::size_t(t)]) continue;  // torn since the build
         const auto& tri = triangles_[std::size_t(t)];
         const TrianglePoint c = closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
@@ -328,9 +382,11 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     std::size_t pairs = 0;
 #pragma omp parallel for schedule(static) reduction(+ : pairs) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
-        contacts_[std::size_t(i)] = nearestContact(i, s);
-        if (contacts_[std::size_t(i)].triangle < 0) continue;
-        force[std::size_t(i)] += contacts_[std::size_t(i)].force;
+        const PointContact& c = contacts_[std::size_t(i)] = nearestContact(i, s);
+        force[std::size_t(i)] += c.pointForce;
+        pairs += std::size_t(c.points);
+        if (c.triangle < 0) continue;
+        force[std::size_t(i)] += c.force;
         ++pairs;
     }
     pairs_ = pairs;

@@ -10,15 +10,18 @@
 //   SIGGRAPH 2002, Section 7.1). Nothing ends a step inside a collider or below the ground.
 // - Self-contact: a particle repels every kept triangle of the sheet within the contact
 //   thickness d whose corners are not bonded to it at rest (farther than the horizon in the rest
-//   lattice), pushing the triangle's corners back by barycentric shares, so momentum is kept.
-//   Point against triangle, not point against point: particles d = dx / 2 apart would let a
-//   sheet pass between another's particles (a triangle's centre is dx / sqrt(3) from its
-//   corners). A damped penalty force with Coulomb friction acts on the nearest such triangle.
-//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin of d,
-//   rebuilt only once some particle has moved d / 2 since (a Verlet list). The penalty's
-//   stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of sheets
-//   under gravity within d / 4) and grows with the fastest particle's speed, so that no approach
-//   at the scene's speeds closes past d / 2.
+//   lattice), pushing the triangle's corners back by barycentric shares, so momentum is kept;
+//   and every particle within d not bonded to it at rest. Triangles, not only particles: a sheet
+//   would pass between another's particles d = dx / 2 apart (a triangle's centre is dx / sqrt(3)
+//   from its corners). Particles too: torn-off bits hold no triangle, and near a crumple two
+//   particles just beyond the horizon share no triangle free of bonds to the other. A damped
+//   penalty force with Coulomb friction acts on the nearest such triangle and on each particle.
+//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin of
+//   1.5 d, rebuilt only once some particle has moved 0.75 d since, relative to the mean motion (a
+//   Verlet list; a skin of d rebuilt 1.4 times as often and 2 d cost as much per build). The
+//   penalty's stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of
+//   sheets under gravity within d / 4) and grows with the fastest particle's speed, so that no
+//   approach at the scene's speeds closes past d / 2.
 // - The step limit: with self-contact, no two particles close by more than d / 4 in a step
 //   (dt <= d / (4 (2 max|v|))), and no particle moves past half a collider's thinnest part.
 
@@ -40,7 +43,7 @@ public:
     /// rest distance within which two particles are bonded; `stiffnessRate`: the penalty
     /// stiffness per unit mass at rest [1/s^2].
     Contact(const ContactParams& params, double thickness, double horizon, double stiffnessRate,
-            std::span<const std::array<int, 3>> triangles);
+            std::span<const std::array<int, 3>> triangles, std::span<const Eigen::Vector3d> rest);
 
     double thickness() const { return thickness_; }
     bool selfContact() const { return params_.self.enabled; }
@@ -79,7 +82,8 @@ public:
     }
     /// The momentum the ground and colliders gave the sheet in the last resolve [N s].
     Eigen::Vector3d lastImpulse() const;
-    /// Particles touching a triangle within d at the last force evaluation.
+    /// Contacts within d at the last force evaluation: particle-triangle ones, and
+    /// particle-particle ones counted from both ends.
     std::size_t lastPairCount() const { return pairs_; }
     /// Candidate-list rebuilds so far.
     long listBuilds() const { return builds_; }
@@ -91,12 +95,16 @@ private:
                  const Eigen::Vector3d& surfaceVelocity, const Friction& friction) const;
     void resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const;
     /// One particle's contact with its nearest triangle: the force on the particle, and the
-    /// triangle that takes it back by barycentric shares.
+    /// triangle that takes it back by barycentric shares; and its contacts with particles.
     struct PointContact {
         int triangle = -1;
         Eigen::Vector3d weights = Eigen::Vector3d::Zero();
         Eigen::Vector3d force = Eigen::Vector3d::Zero();
+        Eigen::Vector3d pointForce = Eigen::Vector3d::Zero();  ///< from particles within d
+        int points = 0;
     };
+    void setUpTriangles(std::span<const std::array<int, 3>> triangles,
+                        std::span<const Eigen::Vector3d> rest, double reach);
     bool listStale(std::span<const Eigen::Vector3d> x) const;
     void buildList(const SheetState& s);
     /// Candidates of particle i within `reach`, appended to out (ascending bucket, triangle).
@@ -123,6 +131,10 @@ private:
     // Verlet list of candidate triangles per particle (CSR), built from a spatial hash of the
     // triangles' centroids with cells of twice the search reach.
     std::vector<std::array<int, 3>> triangles_;
+    /// Rest centroids, and the squared rest distances from one within which every corner, or
+    /// beyond which no corner, is bonded to a particle: one test decides most triangles.
+    std::vector<Eigen::Vector3d> restCentres_;
+    double allBonded2_ = 0.0, noneBonded2_ = 0.0;
     double skin_ = 0.0;
     std::vector<Eigen::Vector3d> builtAt_;  ///< positions at the last build
     std::vector<int> listStart_, list_;

@@ -1,5 +1,7 @@
 #include "sim/Membrane.h"
 
+#include <omp.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -103,7 +105,7 @@ void Membrane::setUpContact(const MembraneParams& params) {
     const double restRate = 2.0 / (stableDt_ * stableDt_);
     const double baseRate =
         std::max(0.25 * restRate, 4.0 * 8.0 * params.gravity.norm() / thickness);
-    contact_.emplace(params.contact, thickness, horizon_, baseRate, lattice_.triangles);
+    contact_.emplace(params.contact, thickness, horizon_, baseRate, lattice_.triangles, x0_);
     if (self.enabled) setStableStep(restRate + 2.0 * baseRate);
     free_.resize(x0_.size());
     for (std::size_t i = 0; i < x0_.size(); ++i) free_[i] = constraint_[i] == kFree;
@@ -185,8 +187,10 @@ void Membrane::integrate(double dt, double tNext) {
 
 void Membrane::collide(double tNext) {
     if (!contact_ || !contact_->hasColliders()) return;
+    const double t0 = omp_get_wtime();
     contact_->place(tNext);
     contact_->resolveColliders(x_, v_, mass_, free_);
+    contactSeconds_ += omp_get_wtime() - t0;
 }
 
 double Membrane::contactStepLimit() const {
@@ -197,9 +201,12 @@ void Membrane::accumulateForces() {
     solver_->advance(stepState(), *workspace_, force_);
     stiffening_ = solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
-    if (contact_ && contact_->selfContact())
+    if (contact_ && contact_->selfContact()) {
+        const double t0 = omp_get_wtime();
         contact_->addSelfContactForces({x_, v_, x0_, mass_, damageState_.keptTriangles(), dt_},
                                        force_);
+        contactSeconds_ += omp_get_wtime() - t0;
+    }
 }
 
 // Follower pressure: each kept triangle (DamageState::keptTriangles) pushes its three corners along

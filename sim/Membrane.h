@@ -77,6 +77,9 @@ public:
     const TimeStepController& stepController() const { return controller_; }
     /// Ground, colliders and self-contact (sim/Contact.h); nullptr when the scene has none.
     const Contact* contact() const { return contact_ ? &*contact_ : nullptr; }
+    /// Wall seconds spent in contact so far (colliders and self-contact), for the share of the
+    /// step it costs.
+    double contactSeconds() const { return contactSeconds_; }
     /// The longest step contact allows at the current speeds (infinite without contact).
     double contactStepLimit() const;
 
@@ -177,6 +180,7 @@ private:
     std::optional<Diffusion> diffusion_;
     std::optional<Contact> contact_;
     std::vector<std::uint8_t> free_;  ///< per particle: 1 unless pinned or driven (contact only)
+    double contactSeconds_ = 0.0;
     double horizon_ = 0.0;
     double stableDt_ = 0.0;
     double dt_ = 0.0;

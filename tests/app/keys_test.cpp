@@ -86,11 +86,30 @@ struct Variation {
 const std::pair<std::string, std::string> kDisc = {"size = [0.2, 0.2]",
                                                    "shape = \"disc\"\nradius = 0.1"};
 
+/// A collider just under the sheet's middle (its top 2 mm below, within the contact offset), so
+/// it lifts the sheet at once; `shape` gives its shape keys.
+std::pair<std::string, std::string> collider(const std::string& shape) {
+    return {"[time]", "[[collider]]\n" + shape + "\n\n[time]"};
+}
+const std::string kSphere = "shape = \"sphere\"\nradius = 0.05\nposition = [0.0, 0.0, -0.052]";
+const std::string kBox = "shape = \"box\"\nsize = [0.1, 0.1, 0.1]\nposition = [0.0, 0.0, -0.052]";
+const std::string kCube = "shape = \"mesh\"\nfile = \"" REND_SOURCE_DIR
+                          "/tests/data/collider_cube.obj\"\nscale = 0.1\nposition = [0.0, 0.0, "
+                          "-0.052]";
+const std::string kKeyed = kSphere +
+                           "\n[[collider.keyframe]]\ntime = 0.0\n[[collider.keyframe]]\ntime = "
+                           "0.05\nposition = [0.0, 0.0, -0.03]";
+
 std::vector<Variation> variations() {
     const std::vector<std::string> embree = {"render.renderer=embree", "render.spp=2"};
     const std::vector<std::string> vdb = {"render.surface=vdb"};
     // Pulled fast enough that bonds near the notch reach their critical stretch.
     const std::vector<std::string> pull = {"boundary.0.velocity=[-2.0, 0.0, 0.0]"};
+    // The sheet falls onto the ground just below it, or lies on itself: a contact thickness
+    // above the horizon puts particles of one flat sheet within it of each other.
+    const std::vector<std::string> fall = {"forces.gravity=[0.0, 0.0, -50.0]",
+                                           "render.ground_height=-0.004"};
+    const std::vector<std::string> touching = {"contact.self=true", "contact.thickness=0.05"};
     return {
         {"solver", {"solver=fem_cst"}},
         {"sheet.shape", {"sheet.shape=disc"}, {}, {"size = [0.2, 0.2]", "radius = 0.1"}},
@@ -157,6 +176,49 @@ std::vector<Variation> variations() {
         {"diffusion.edge[].box.max", {"diffusion.edge.1.box.max=[-0.02, -0.05]"}},
         {"diffusion.edge[].value", {"diffusion.edge.0.value=2"}},
         {"forces.gravity", {"forces.gravity=[0.0, 0.0, -5.0]"}},
+        {"contact.ground", {"contact.ground=false"}, fall},
+        {"contact.ground_friction", {"contact.ground_friction=0.0"}, fall},
+        {"contact.ground_static_friction", {"contact.ground_static_friction=3.0"}, fall},
+        {"contact.self", {"contact.self=true"}},
+        {"contact.thickness", {"contact.thickness=0.004"}, fall},
+        {"contact.friction", {"contact.friction=0.0", "contact.static_friction=0.0"}, touching},
+        {"contact.static_friction", {"contact.static_friction=3.0"}, touching},
+        {"collider[].shape",
+         {"collider.0.shape=capsule", "collider.0.length=0.1"},
+         {},
+         collider(kSphere)},
+        {"collider[].radius", {"collider.0.radius=0.06"}, {}, collider(kSphere)},
+        {"collider[].size", {"collider.0.size=[0.1, 0.1, 0.11]"}, {}, collider(kBox)},
+        {"collider[].length",
+         {"collider.0.length=0.2"},
+         {"collider.0.shape=capsule", "collider.0.length=0.1"},
+         collider(kSphere)},
+        {"collider[].file",
+         {"collider.0.file=\"" REND_SOURCE_DIR "/tests/data/collider_octahedron.obj\""},
+         {},
+         collider(kCube)},
+        {"collider[].scale", {"collider.0.scale=0.12"}, {}, collider(kCube)},
+        {"collider[].position", {"collider.0.position=[0.01, 0.0, -0.052]"}, {}, collider(kSphere)},
+        {"collider[].rotation", {"collider.0.rotation=[0.0, 0.0, 30.0]"}, {}, collider(kBox)},
+        {"collider[].velocity", {"collider.0.velocity=[0.0, 0.0, 0.3]"}, {}, collider(kSphere)},
+        {"collider[].spin", {"collider.0.spin=[0.0, 0.0, 200.0]"}, {}, collider(kBox)},
+        {"collider[].keyframe[].time", {"collider.0.keyframe.1.time=0.08"}, {}, collider(kKeyed)},
+        {"collider[].keyframe[].position",
+         {"collider.0.keyframe.1.position=[0.0, 0.0, -0.04]"},
+         {},
+         collider(kKeyed)},
+        {"collider[].keyframe[].rotation",
+         {"collider.0.keyframe.1.rotation=[0.0, 0.0, 60.0]"},
+         {"collider.0.shape=capsule", "collider.0.length=0.1"},
+         collider(kKeyed)},
+        {"collider[].friction", {"collider.0.friction=0.0"}, {}, collider(kSphere)},
+        {"collider[].static_friction", {"collider.0.static_friction=3.0"}, {}, collider(kSphere)},
+        {"collider[].color", {"collider.0.color=[0.9, 0.1, 0.1]"}, {}, collider(kSphere)},
+        {"collider[].roughness",
+         {"collider.0.roughness=0.1"},
+         {"render.renderer=embree", "render.spp=2", "collider.0.metal=true"},
+         collider(kSphere)},
+        {"collider[].metal", {"collider.0.metal=true"}, {}, collider(kSphere)},
         {"forces.damping", {"forces.damping=1"}},
         {"forces.pressure", {"forces.pressure=10"}},
         {"time.dt", {"time.dt=1e-3"}},

@@ -259,8 +259,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"bad_unknown_key.toml",
                  "6:2",
                  {"unknown key 'materal' in the top-level table; expected one of: solver, sheet, "
-                  "material, boundary, notch, diffusion, forces, time, camera, light, render, "
-                  "output. Did "
+                  "material, boundary, notch, diffusion, forces, contact, collider, time, camera, "
+                  "light, render, output. Did "
                   "you mean 'material'?"}},
         BadScene{"bad_sub_key.toml",
                  "13:1",

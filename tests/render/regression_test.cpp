@@ -14,6 +14,7 @@
 #include <variant>
 
 #include "TestSupport.h"
+#include "render/ColliderMesh.h"
 #include "render/EmbreeRenderer.h"
 #include "render/Geometry.h"
 #include "render/Image.h"
@@ -141,3 +142,49 @@ INSTANTIATE_TEST_SUITE_P(RenderRegression, EveryRendererAndSurface,
                              return name(std::get<0>(info.param)) + "_" +
                                     name(std::get<1>(info.param));
                          });
+
+namespace {
+
+// A 0.4 m sheet dropped onto a ball on the ground, with self-contact, half a second on: the
+// frame with contact the renderers draw (the sheet draped over the ball, the ball in its look).
+sim::Membrane drapedSheet() {
+    sim::MembraneParams p;
+    p.sheet.size = {0.4, 0.4};
+    p.sheet.dx = 0.02;
+    p.sheet.center = {0.0, 0.0, 0.2};
+    p.material.youngsModulus = 1e5;
+    p.material.density = 1000;
+    p.gravity = {0.0, 0.0, -9.81};
+    p.damping = 1.0;
+    p.contact.ground = {true, -0.1, {0.5, 0.5}};
+    p.contact.self.enabled = true;
+    sim::ColliderParams ball;
+    ball.radius = 0.14;
+    ball.position = {0.0, 0.0, 0.04};  // on the ground, its lower half bare
+    p.contact.colliders.push_back(ball);
+    sim::Membrane m(p);
+    m.advanceTo(0.5);
+    return m;
+}
+
+}  // namespace
+
+TEST(RenderRegression, AFrameWithContactMatchesItsReference) {
+    const sim::Membrane m = drapedSheet();
+    const sim::FrameView frame = m.view(1);
+    render::RenderSettings settings = frameSettings();
+    settings.colorBy = render::ColorBy::None;
+    settings.camera.position = Eigen::Vector3d(0.3, -0.55, 0.35);
+    settings.camera.lookAt = Eigen::Vector3d(0.0, 0.0, 0.02);
+    settings.colliderLooks = {render::ColliderLook{{0.7, 0.15, 0.1}, 0.5, false}};
+    const render::Mesh mesh = render::LatticeSurface(frame).build(frame, settings);
+    const std::vector<render::Mesh> colliders = render::colliderMeshes(frame);
+    ASSERT_EQ(colliders.size(), 1u);
+    const render::Image image = render::OsmesaRenderer().render(mesh, settings, colliders);
+    const render::Image sheetOnly = render::OsmesaRenderer().render(mesh, settings);
+    EXPECT_GT(rend::test::pixelsDiffering(image, sheetOnly, 8), 100) << "the ball shows";
+    double lowest = 1e300;
+    for (const Eigen::Vector3d& x : m.positions()) lowest = std::min(lowest, x.z());
+    EXPECT_GE(lowest, -0.1) << "nothing below the ground";
+    rend::test::expectMatchesReference(image, "regress_osmesa_contact");
+}

@@ -10,6 +10,7 @@
 
 #include "sim/ColliderDistance.h"
 #include "sim/Membrane.h"
+#include "sim/SolverRegistry.h"
 
 using namespace rend::sim;
 
@@ -270,4 +271,20 @@ TEST(Contact, KeyframedPosesInterpolateAndTheirVelocitiesMatchTheMotion) {
     EXPECT_LT((moving - mid.velocityAt(mid.toWorld(local))).norm(), 1e-6);
     EXPECT_LT((c.poseAt(2.0).position - Eigen::Vector3d(1, 2, 0)).norm(), 1e-12) << "holds";
     EXPECT_EQ(c.poseAt(2.0).velocity.norm(), 0.0);
+}
+
+TEST(Contact, EverySolverGetsContactThroughTheMembrane) {
+    for (const std::string_view name : solverNames()) {
+        MembraneParams p = slidingSheet(0.5);
+        p.solver = std::string(name);
+        p.contact.self.enabled = true;
+        Membrane m(p);
+        const double speed = 0.3;
+        setVelocity(m, {speed, 0.0, 0.0});
+        while (m.time() < p.time.duration) m.step();
+        EXPECT_LT(m.maxSpeed(), 1e-6) << name;
+        const double slide = speed * speed / (2 * 0.5 * kGravity);
+        EXPECT_NEAR(centroid(m).x(), slide, 0.05 * slide) << name;
+        EXPECT_GE(lowest(m), 0.0) << name;
+    }
 }

@@ -21,6 +21,12 @@ constexpr double kStepFraction = 0.25;
 /// (kStopping / 4)^2 times their kinetic energy), and with the step limit a contact's own
 /// frequency stays at sqrt(rate) dt <= kStopping kStepFraction / 2 = 0.625.
 constexpr double kStopping = 5.0;
+/// The candidate lists' skin, in units of d: at first, and its bounds. A list lasts until some
+/// particle has moved skin / 2; each build sizes the next skin so that a list lasts about
+/// kListSteps steps at the speeds the last one saw: a fast scene (a falling sheet) rebuilds less
+/// often with a wide skin, a slow one (a pile at rest) checks fewer candidates with a thin one.
+constexpr double kSkin = 1.0, kSkinMin = 0.25, kSkinMax = 2.0;
+constexpr long kListSteps = 24;
 
 Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
     return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
@@ -37,7 +43,7 @@ Contact::Contact(const ContactParams& params, double thickness, double horizon,
       baseStiffnessRate_(stiffnessRate) {
     const double reach = horizon * (1.0 + 1e-9);  // the bond families' own reach (Bonds.cpp)
     restExclusion2_ = reach * reach;
-    skin_ = 1.5 * thickness_;
+    skin_ = kSkin * thickness_;
     if (params_.self.enabled) setUpTriangles(triangles, rest, reach);
     meshes_.resize(params_.colliders.size());
     for (std::size_t c = 0; c < params_.colliders.size(); ++c) {
@@ -171,25 +177,31 @@ public:
         for (std::uint32_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
         items_.resize(n);
         cells_.resize(n);
+        points_.resize(n);
         std::vector<int> fill(start_.begin(), start_.end() - 1);
         for (std::size_t i = 0; i < n; ++i) {
             const std::size_t at = std::size_t(fill[bucket[i]]++);
             items_[at] = int(i);
             cells_[at] = cell[i];
+            points_[at] = points[i];
         }
     }
 
-    /// Calls f(item) for every item in the 27 cells about x (a superset of those within r).
+    /// Calls f(item) for every item within r of x, from the 27 cells about x. The items' points
+    /// are stored in bucket order, so the scan reads memory in sequence.
     template <class F>
     void near(const Eigen::Vector3d& x, F&& f) const {
         const Eigen::Vector3i c = cellOf(x);
+        const double r2 = cell_ * cell_;
         for (int z = -1; z <= 1; ++z)
             for (int y = -1; y <= 1; ++y)
                 for (int w = -1; w <= 1; ++w) {
                     const Eigen::Vector3i cell = c + Eigen::Vector3i(w, y, z);
                     const std::uint32_t b = bucketOf(cell);
                     for (int s = start_[b]; s < start_[b + 1]; ++s)
-                        if (cells_[std::size_t(s)] == cell) f(items_[std::size_t(s)]);
+                        if ((points_[std::size_t(s)] - x).squaredNorm() < r2 &&
+                            cells_[std::size_t(s)] == cell)
+                            f(items_[std::size_t(s)]);
                 }
     }
 
@@ -208,6 +220,7 @@ private:
     std::uint32_t mask_ = 0;
     std::vector<int> start_, items_;
     std::vector<Eigen::Vector3i> cells_;
+    std::vector<Eigen::Vector3d> points_;
 };
 
 }  // namespace
@@ -226,6 +239,16 @@ bool Contact::listStale(std::span<const Eigen::Vector3d> x) const {
 #pragma omp parallel for schedule(static) reduction(max : moved) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i] - mean).squaredNorm());
     return moved > limit;
+}
+
+// The skin scales with how long the last list lasted (in force evaluations, the same for any
+// thread count), at most halved or doubled at once.
+void Contact::sizeNextSkin() {
+    const long lasted = evaluations_ - builtAtEvaluation_;
+    builtAtEvaluation_ = evaluations_;
+    if (builds_ <= 1 || lasted <= 0) return;
+    const double scale = std::clamp(double(kListSteps) / double(lasted), 0.5, 2.0);
+    skin_ = std::clamp(skin_ * scale, kSkinMin * thickness_, kSkinMax * thickness_);
 }
 
 bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
@@ -279,8 +302,7 @@ void Contact::buildList(const SheetState& s) {
     const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
         triangleCandidates(i, out);
         points.near(s.x[i], [&](int j) {
-            if (j == i || (s.x[i] - s.x[j]).squaredNorm() >= reach * reach) return;
-            if ((s.rest[i] - s.rest[j]).squaredNorm() <= restExclusion2_) return;
+            if (j == i || (s.rest[i] - s.rest[j]).squaredNorm() <= restExclusion2_) return;
             out.emplace_back(i, -(j + 1));  // a particle: negative
         });
     };
@@ -303,6 +325,7 @@ void Contact::buildList(const SheetState& s) {
     for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
     builtAt_.assign(s.x.begin(), s.x.end());
     ++builds_;
+    sizeNextSkin();
 }
 
 // The force on particle i from the point of triangle `tri` with barycentric weights w: a damped
@@ -370,6 +393,7 @@ Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const 
 }
 
 void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vector3d>& force) {
+    ++evaluations_;
     if (listStale(s.x)) buildList(s);
     const int n = int(s.x.size());
     double fastest = 0.0;  // squared

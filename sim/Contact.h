@@ -16,9 +16,9 @@
 //   from its corners). Particles too: torn-off bits hold no triangle, and near a crumple two
 //   particles just beyond the horizon share no triangle free of bonds to the other. A damped
 //   penalty force with Coulomb friction acts on the nearest such triangle and on each particle.
-//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin of
-//   1.5 d, rebuilt only once some particle has moved 0.75 d since, relative to the mean motion (a
-//   Verlet list; a skin of d rebuilt 1.4 times as often and 2 d cost as much per build). The
+//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin,
+//   rebuilt only once some particle has moved half the skin since, relative to the mean motion
+//   (a Verlet list). The skin adapts so that a list lasts about 24 steps (Contact.cpp). The
 //   penalty's stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of
 //   sheets under gravity within d / 4) and grows with the fastest particle's speed, so that no
 //   approach at the scene's speeds closes past d / 2.
@@ -106,6 +106,7 @@ private:
     void setUpTriangles(std::span<const std::array<int, 3>> triangles,
                         std::span<const Eigen::Vector3d> rest, double reach);
     bool listStale(std::span<const Eigen::Vector3d> x) const;
+    void sizeNextSkin();
     void buildList(const SheetState& s);
     /// Candidates of particle i within `reach`, appended to out (ascending bucket, triangle).
     void collectCandidates(int i, const SheetState& s, double reach, std::vector<int>& out) const;
@@ -136,7 +137,8 @@ private:
     std::vector<Eigen::Vector3d> restCentres_;
     double allBonded2_ = 0.0, noneBonded2_ = 0.0;
     double skin_ = 0.0;
-    std::vector<Eigen::Vector3d> builtAt_;  ///< positions at the last build
+    long evaluations_ = 0, builtAtEvaluation_ = 0;  ///< force evaluations: all, at the last build
+    std::vector<Eigen::Vector3d> builtAt_;          ///< positions at the last build
     std::vector<int> listStart_, list_;
     std::vector<PointContact> contacts_;  ///< per particle, this evaluation's
     std::size_t pairs_ = 0;

@@ -141,6 +141,19 @@ sim::ColliderParams readCollider(const TableReader& t, const Scene& scene) {
     return c;
 }
 
+/// Particles farther apart at rest than the horizon R are not bonded, so a contact thickness of R
+/// or more would have the sheet repel itself where it lies flat.
+void checkThickness(const TableReader& t, double thickness, const sim::SheetParams& sheet) {
+    const double horizon = sheet.horizonFactor * sheet.dx;
+    if (thickness < horizon) return;
+    t.fail("thickness",
+           "a contact thickness below the horizon R = " + formatNumber(horizon) +
+               " m at this quality's spacing, or the sheet repels itself where it lies flat",
+           formatNumber(thickness),
+           "Remove thickness (the default is dx / 2 at every quality), or use e.g. thickness = " +
+               formatNumber(0.5 * sheet.dx) + ".");
+}
+
 }  // namespace
 
 void readContact(const TableReader& root, Scene& scene) {
@@ -151,6 +164,7 @@ void readContact(const TableReader& root, Scene& scene) {
     c.ground.friction = readFriction(t, "ground_friction", "ground_static_friction", 0.5);
     c.self.enabled = t.boolean("self").value_or(false);
     c.self.thickness = t.number("thickness").value_or(0.0);
+    checkThickness(t, c.self.thickness, scene.sim.sheet);
     c.self.friction = readFriction(t, "friction", "static_friction", 0.3);
     for (const TableReader& entry : root.entries("collider")) {
         c.colliders.push_back(readCollider(entry, scene));

@@ -104,7 +104,8 @@ void MeshDistance::buildPseudoNormals() {
         for (int k = 0; k < 3; ++k) {
             const int a = tri[k], b = tri[(k + 1) % 3], c = tri[(k + 2) % 3];
             vertexNormal_[a] += cornerAngle(vertices_[a], vertices_[b], vertices_[c]) * n;
-            edgeSum[std::minmax(a, b)] += n;
+            // try_emplace zeroes it: Eigen leaves a default-constructed vector uninitialised.
+            edgeSum.try_emplace(std::minmax(a, b), Eigen::Vector3d::Zero()).first->second += n;
         }
     }
     for (Eigen::Vector3d& n : vertexNormal_) n.normalize();

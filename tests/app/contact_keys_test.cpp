@@ -102,6 +102,7 @@ TEST(ContactKeys, EveryMistakeIsRefusedAtItsLocation) {
         13, "at least the kinetic");
     expectRefused("[contact]\nfriction = -1\n", 10, "friction");
     expectRefused("[contact]\nthickness = 0\n", 10, "thickness");
+    expectRefused("[contact]\nthickness = 0.03\n", 10, "below the horizon R = 0.03");
     expectRefused(
         "[[collider]]\nshape = \"sphere\"\nradius = 0.1\n[[collider.keyframe]]\n"
         "time = 1.0\n[[collider.keyframe]]\ntime = 0.5\n",

@@ -105,11 +105,12 @@ std::vector<Variation> variations() {
     const std::vector<std::string> vdb = {"render.surface=vdb"};
     // Pulled fast enough that bonds near the notch reach their critical stretch.
     const std::vector<std::string> pull = {"boundary.0.velocity=[-2.0, 0.0, 0.0]"};
-    // The sheet falls onto the ground just below it, or lies on itself: a contact thickness
-    // above the horizon puts particles of one flat sheet within it of each other.
+    // The sheet falls onto the ground just below it, or is pushed together from its left edge
+    // until parts of it not bonded at rest touch.
     const std::vector<std::string> fall = {"forces.gravity=[0.0, 0.0, -50.0]",
                                            "render.ground_height=-0.004"};
-    const std::vector<std::string> touching = {"contact.self=true", "contact.thickness=0.05"};
+    const std::vector<std::string> touching = {"contact.self=true", "contact.thickness=0.025",
+                                               "boundary.0.velocity=[1.0, 0.0, 0.0]"};
     return {
         {"solver", {"solver=fem_cst"}},
         {"sheet.shape", {"sheet.shape=disc"}, {}, {"size = [0.2, 0.2]", "radius = 0.1"}},

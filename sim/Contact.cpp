@@ -394,7 +394,12 @@ Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const 
 
 void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vector3d>& force) {
     ++evaluations_;
-    if (listStale(s.x)) buildList(s);
+    // A list that outlives its target by far was built with too wide a skin for this scene's
+    // speeds (a pile at rest): rebuilding it lets the skin shrink, and the next lists hold fewer
+    // candidates.
+    const bool overdue =
+        evaluations_ - builtAtEvaluation_ > 4 * kListSteps && skin_ > kSkinMin * thickness_;
+    if (overdue || listStale(s.x)) buildList(s);
     const int n = int(s.x.size());
     double fastest = 0.0;  // squared
 #pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)

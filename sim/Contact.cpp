@@ -2,11 +2,14 @@
 
 #include <omp.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "sim/Parallel.h"
+#include "sim/PointHash.h"
 
 namespace rend::sim {
 namespace {
@@ -27,6 +30,11 @@ constexpr double kStopping = 5.0;
 /// often with a wide skin, a slow one (a pile at rest) checks fewer candidates with a thin one.
 constexpr double kSkin = 1.0, kSkinMin = 0.25, kSkinMax = 2.0;
 constexpr long kListSteps = 24;
+/// ContactCulling's tiles, in units of the bond reach: wide enough that tiles two apart are
+/// told apart by their bounding spheres, narrow enough that a gently bent sheet fits an affine
+/// map over three of them.
+constexpr double kTileSize = 3.0;
+constexpr double kCullingReach = 0.5;
 
 Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
     return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
@@ -67,6 +75,12 @@ void Contact::setUpTriangles(std::span<const std::array<int, 3>> triangles,
     }
     allBonded2_ = reach > widest ? (reach - widest) * (reach - widest) : -1.0;
     noneBonded2_ = (reach + widest) * (reach + widest);
+    culling_.emplace(rest, triangles, reach * reach, kTileSize * reach);
+    // The widest skin that leaves ContactCulling room: on an undeformed sheet the reach d + skin
+    // is at most kCullingReach of the rest clearance, and residuals of a quarter of it pass.
+    skinCap_ = std::clamp(kCullingReach * culling_->restClearance() - thickness_,
+                          kSkinMin * thickness_, kSkinMax * thickness_);
+    skin_ = std::min(skin_, skinCap_);
 }
 
 void Contact::place(double t) {
@@ -159,86 +173,89 @@ double Contact::stepLimit(double maxSpeed) const {
 
 namespace {
 
-class PointHash {
-public:
-    PointHash(std::span<const Eigen::Vector3d> points, double radius) : cell_(radius) {
-        const std::size_t n = points.size();
-        std::uint32_t buckets = 1;
-        while (buckets < 2 * n) buckets <<= 1;
-        mask_ = buckets - 1;
-        std::vector<std::uint32_t> bucket(n);
-        std::vector<Eigen::Vector3i> cell(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            cell[i] = cellOf(points[i]);
-            bucket[i] = bucketOf(cell[i]);
-        }
-        start_.assign(std::size_t(buckets) + 1, 0);
-        for (std::size_t i = 0; i < n; ++i) ++start_[bucket[i] + 1];
-        for (std::uint32_t b = 0; b < buckets; ++b) start_[b + 1] += start_[b];
-        items_.resize(n);
-        cells_.resize(n);
-        points_.resize(n);
-        std::vector<int> fill(start_.begin(), start_.end() - 1);
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t at = std::size_t(fill[bucket[i]]++);
-            items_[at] = int(i);
-            cells_[at] = cell[i];
-            points_[at] = points[i];
-        }
-    }
-
-    /// Calls f(item) for every item within r of x, from the 27 cells about x. The items' points
-    /// are stored in bucket order, so the scan reads memory in sequence.
-    template <class F>
-    void near(const Eigen::Vector3d& x, F&& f) const {
-        const Eigen::Vector3i c = cellOf(x);
-        const double r2 = cell_ * cell_;
-        for (int z = -1; z <= 1; ++z)
-            for (int y = -1; y <= 1; ++y)
-                for (int w = -1; w <= 1; ++w) {
-                    const Eigen::Vector3i cell = c + Eigen::Vector3i(w, y, z);
-                    const std::uint32_t b = bucketOf(cell);
-                    for (int s = start_[b]; s < start_[b + 1]; ++s)
-                        if ((points_[std::size_t(s)] - x).squaredNorm() < r2 &&
-                            cells_[std::size_t(s)] == cell)
-                            f(items_[std::size_t(s)]);
-                }
-    }
-
-private:
-    Eigen::Vector3i cellOf(const Eigen::Vector3d& x) const {
-        return (x / cell_).array().floor().cast<int>();
-    }
-    std::uint32_t bucketOf(const Eigen::Vector3i& c) const {
-        const std::uint64_t h = std::uint64_t(std::int64_t(c.x())) * 73856093u ^
-                                std::uint64_t(std::int64_t(c.y())) * 19349663u ^
-                                std::uint64_t(std::int64_t(c.z())) * 83492791u;
-        return std::uint32_t(h ^ (h >> 32)) & mask_;
-    }
-
-    double cell_;
-    std::uint32_t mask_ = 0;
-    std::vector<int> start_, items_;
-    std::vector<Eigen::Vector3i> cells_;
-    std::vector<Eigen::Vector3d> points_;
-};
+/// The sum of f(i) over [0, n) by fixed blocks, each summed in order, the blocks added in order:
+/// the same bits for any thread count.
+template <class T, class F>
+T blockSum(int n, T zero, F&& f) {
+    constexpr int kBlock = 4096;
+    const int blocks = (n + kBlock - 1) / kBlock;
+    std::vector<T> part(std::size_t(blocks), zero);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int b = 0; b < blocks; ++b)
+        for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
+            part[std::size_t(b)] += f(i);
+    T sum = zero;
+    for (const T& p : part) sum += p;
+    return sum;
+}
 
 }  // namespace
 
 // A common translation changes no distance, so the list goes stale only once two particles may
 // have closed by the skin: some particle has moved more than skin / 2 relative to the mean
-// displacement (a falling sheet keeps its list).
+// displacement (a falling sheet keeps its list). Past that, a stretching sheet may still keep
+// it: see staleAfterAffineFit.
 bool Contact::listStale(std::span<const Eigen::Vector3d> x) const {
     if (builtAt_.size() != x.size()) return true;
     const int n = int(x.size());
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // in particle order: the same bits always
-    for (int i = 0; i < n; ++i) mean += x[i] - builtAt_[i];
-    mean /= n;
+    const Eigen::Vector3d mean =
+        blockSum(n, Eigen::Vector3d::Zero().eval(), [&](int i) { return x[i] - builtAt_[i]; }) /
+        double(n);
     const double limit = 0.25 * skin_ * skin_;  // (skin / 2)^2
     double moved = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : moved) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i] - mean).squaredNorm());
-    return moved > limit;
+    return moved > limit && staleAfterAffineFit(x, mean);
+}
+
+// The displacement since the build fitted by least squares as u = mean + G (X - centre), with
+// F = I + G and r_i the residuals. Two points p, q of the build (particles, or points of
+// triangles) at distance s are now at least sigma s - 2 max|r| apart, sigma the smallest
+// singular value of F over the directions the build spans (a triangle's points are convex
+// combinations of its corners, so each is off F's image by at most max|r| too). Everything left
+// out of the list was at least d + skin away, so the list holds while
+// sigma (d + skin) - 2 max|r| >= d. A sheet drawn apart keeps its list as long as it does not
+// crumple or shrink across by skin / (d + skin).
+bool Contact::staleAfterAffineFit(std::span<const Eigen::Vector3d> x,
+                                  const Eigen::Vector3d& mean) const {
+    if (builtSpan_.cols() == 0) return true;
+    const int n = int(x.size());
+    const Eigen::Matrix3d cross = blockSum(n, Eigen::Matrix3d::Zero().eval(), [&](int i) {
+        return ((x[i] - builtAt_[i]) * (builtAt_[i] - builtCentre_).transpose()).eval();
+    });
+    const Eigen::Matrix3d g = cross * builtScatterInverse_;
+    double residual = 0.0;  // squared
+#pragma omp parallel for schedule(static) reduction(max : residual) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i)
+        residual = std::max(
+            residual, (x[i] - builtAt_[i] - mean - g * (builtAt_[i] - builtCentre_)).squaredNorm());
+    const Eigen::MatrixXd image = (Eigen::Matrix3d::Identity() + g) * builtSpan_;
+    const double sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(image).singularValues().minCoeff();
+    return sigma * (thickness_ + skin_) - 2.0 * std::sqrt(residual) < thickness_;
+}
+
+// The build positions' centre and scatter, for staleAfterAffineFit.
+void Contact::fitBuiltPositions() {
+    const int n = int(builtAt_.size());
+    builtCentre_ = blockSum(n, Eigen::Vector3d::Zero().eval(), [&](int i) { return builtAt_[i]; }) /
+                   double(std::max(n, 1));
+    const Eigen::Matrix3d scatter = blockSum(n, Eigen::Matrix3d::Zero().eval(), [&](int i) {
+        const Eigen::Vector3d c = builtAt_[i] - builtCentre_;
+        return (c * c.transpose()).eval();
+    });
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    const double largest = eigen.eigenvalues().maxCoeff();
+    builtScatterInverse_.setZero();
+    std::vector<Eigen::Vector3d> span;
+    for (int k = 0; k < 3; ++k) {
+        const double lambda = eigen.eigenvalues()[k];
+        if (!(largest > 0.0) || lambda <= 1e-12 * largest) continue;
+        const Eigen::Vector3d q = eigen.eigenvectors().col(k);
+        builtScatterInverse_ += q * q.transpose() / lambda;
+        span.push_back(q);
+    }
+    builtSpan_.resize(3, Eigen::Index(span.size()));
+    for (std::size_t k = 0; k < span.size(); ++k) builtSpan_.col(Eigen::Index(k)) = span[k];
 }
 
 // The skin scales with how long the last list lasted (in force evaluations, the same for any
@@ -248,7 +265,7 @@ void Contact::sizeNextSkin() {
     builtAtEvaluation_ = evaluations_;
     if (builds_ <= 1 || lasted <= 0) return;
     const double scale = std::clamp(double(kListSteps) / double(lasted), 0.5, 2.0);
-    skin_ = std::clamp(skin_ * scale, kSkinMin * thickness_, kSkinMax * thickness_);
+    skin_ = std::clamp(skin_ * scale, kSkinMin * thickness_, skinCap_);
 }
 
 bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
@@ -265,24 +282,39 @@ bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
 // order, so the lists do not depend on the thread count.
 void Contact::buildList(const SheetState& s) {
     const int n = int(s.x.size());
+    const double reach = thickness_ + skin_;
+    // Only the particles ContactCulling marks 1 can have anything within reach, and only
+    // triangles with a corner marked 1 or 2 can be it.
+    std::vector<std::uint8_t> active;
+    lastActive_ = culling_->mark(s.x, reach, triangles_, s.kept, active);
     // The kept triangles (torn ones are never touched) and the largest distance from one's
     // centroid to its corners.
     double widest = 0.0;
     std::vector<int> kept;
     std::vector<Eigen::Vector3d> centres;
     std::vector<double> radii;  // each triangle's own
-    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+    for (std::size_t t = 0; lastActive_ > 0 && t < triangles_.size(); ++t) {
         if (!s.kept.empty() && !s.kept[t]) continue;
+        const auto& tri = triangles_[t];
+        if (!active[std::size_t(tri[0])] && !active[std::size_t(tri[1])] &&
+            !active[std::size_t(tri[2])])
+            continue;  // within reach of no particle marked 1 (ContactCulling::mark)
         kept.push_back(int(t));
-        centres.push_back(centroid(triangles_[t], s.x));
-        double r = 0.0;
-        for (const int c : triangles_[t]) r = std::max(r, (s.x[c] - centres.back()).norm());
-        radii.push_back(r);
-        widest = std::max(widest, r);
+        centres.push_back(centroid(tri, s.x));
+        double r2 = 0.0;
+        for (const int c : tri) r2 = std::max(r2, (s.x[c] - centres.back()).squaredNorm());
+        radii.push_back(std::sqrt(r2));
+        widest = std::max(widest, radii.back());
     }
-    const double reach = thickness_ + skin_, search = reach + widest;
-    const PointHash hash(centres, search);
-    const PointHash points(s.x, reach);
+    std::vector<int> searched;
+    std::vector<Eigen::Vector3d> searchedAt;
+    for (int i = 0; i < n; ++i)
+        if (active[std::size_t(i)] == 1) {
+            searched.push_back(i);
+            searchedAt.push_back(s.x[i]);
+        }
+    const PointHash hash(centres, reach + widest);
+    const PointHash points(searchedAt, reach);
     const auto triangleCandidates = [&](int i, std::vector<std::pair<int, int>>& out) {
         hash.near(s.x[i], [&](int k) {
             const int t = kept[std::size_t(k)];
@@ -301,7 +333,8 @@ void Contact::buildList(const SheetState& s) {
     };
     const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
         triangleCandidates(i, out);
-        points.near(s.x[i], [&](int j) {
+        points.near(s.x[i], [&](int k) {
+            const int j = searched[std::size_t(k)];
             if (j == i || (s.rest[i] - s.rest[j]).squaredNorm() <= restExclusion2_) return;
             out.emplace_back(i, -(j + 1));  // a particle: negative
         });
@@ -313,7 +346,8 @@ void Contact::buildList(const SheetState& s) {
         found.resize(std::size_t(omp_get_num_threads()));
         std::vector<std::pair<int, int>>& mine = found[std::size_t(omp_get_thread_num())];
 #pragma omp for schedule(static)
-        for (int i = 0; i < n; ++i) candidates(i, mine);
+        for (int i = 0; i < n; ++i)
+            if (active[std::size_t(i)] == 1) candidates(i, mine);
     }
     listStart_.assign(std::size_t(n) + 1, 0);
     list_.clear();
@@ -323,7 +357,11 @@ void Contact::buildList(const SheetState& s) {
             list_.push_back(t);
         }
     for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
+    listed_.clear();
+    for (int i = 0; i < n; ++i)
+        if (listStart_[std::size_t(i) + 1] > listStart_[std::size_t(i)]) listed_.push_back(i);
     builtAt_.assign(s.x.begin(), s.x.end());
+    fitBuiltPositions();
     ++builds_;
     sizeNextSkin();
 }
@@ -400,6 +438,8 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     const bool overdue =
         evaluations_ - builtAtEvaluation_ > 4 * kListSteps && skin_ > kSkinMin * thickness_;
     if (overdue || listStale(s.x)) buildList(s);
+    pairs_ = 0;
+    if (listed_.empty()) return;  // nothing within reach of anything: no force to add
     const int n = int(s.x.size());
     double fastest = 0.0;  // squared
 #pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
@@ -407,11 +447,13 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     stiffnessRate_ =
         std::max(baseStiffnessRate_, kStopping * kStopping * fastest / (thickness_ * thickness_));
     dampingRate_ = 2.0 * kContactDamping * std::sqrt(stiffnessRate_);
-    contacts_.resize(std::size_t(n));
+    const int listed = int(listed_.size());
+    contacts_.resize(listed_.size());
     std::size_t pairs = 0;
-#pragma omp parallel for schedule(static) reduction(+ : pairs) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        const PointContact& c = contacts_[std::size_t(i)] = nearestContact(i, s);
+#pragma omp parallel for schedule(static) reduction(+ : pairs) if (listed >= kParallelThreshold)
+    for (int k = 0; k < listed; ++k) {
+        const int i = listed_[std::size_t(k)];
+        const PointContact& c = contacts_[std::size_t(k)] = nearestContact(i, s);
         force[std::size_t(i)] += c.pointForce;
         pairs += std::size_t(c.points);
         if (c.triangle < 0) continue;
@@ -420,11 +462,12 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     }
     pairs_ = pairs;
     // The triangles' shares, in particle order: the same sums for any thread count.
-    for (int i = 0; pairs > 0 && i < n; ++i) {
-        const PointContact& c = contacts_[std::size_t(i)];
+    for (std::size_t k = 0; pairs > 0 && k < contacts_.size(); ++k) {
+        const PointContact& c = contacts_[k];
         if (c.triangle < 0) continue;
         const auto& tri = triangles_[std::size_t(c.triangle)];
-        for (int k = 0; k < 3; ++k) force[std::size_t(tri[k])] -= c.weights[k] * c.force;
+        for (int corner = 0; corner < 3; ++corner)
+            force[std::size_t(tri[corner])] -= c.weights[corner] * c.force;
     }
 }
 

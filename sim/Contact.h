@@ -16,9 +16,14 @@
 //   from its corners). Particles too: torn-off bits hold no triangle, and near a crumple two
 //   particles just beyond the horizon share no triangle free of bonds to the other. A damped
 //   penalty force with Coulomb friction acts on the nearest such triangle and on each particle.
-//   Candidates come from a spatial hash of triangle centroids into a list padded by a skin,
-//   rebuilt only once some particle has moved half the skin since, relative to the mean motion
-//   (a Verlet list). The skin adapts so that a list lasts about 24 steps (Contact.cpp). The
+//   A list build first leaves out the parts of the sheet too smooth to touch anything not
+//   bonded to them at rest (ContactCulling.h: a flat, stretched or gently bent sheet costs a
+//   fit per tile, not a search per particle). For the rest, candidates come from a spatial hash
+//   of triangle centroids into a list padded by a skin,
+//   rebuilt only once some particle has moved half the skin since, relative to the mean motion,
+//   and the affine motion fitted since the build cannot vouch for it either (a sheet drawn
+//   apart keeps its list; Contact::staleAfterAffineFit) (a Verlet list). The skin adapts so that a
+//   list lasts about 24 steps, up to a cap that leaves the culling room (Contact.cpp). The
 //   penalty's stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of
 //   sheets under gravity within d / 4) and grows with the fastest particle's speed, so that no
 //   approach at the scene's speeds closes past d / 2.
@@ -34,6 +39,7 @@
 
 #include "sim/Collider.h"
 #include "sim/ColliderDistance.h"
+#include "sim/ContactCulling.h"
 
 namespace rend::sim {
 
@@ -87,6 +93,9 @@ public:
     std::size_t lastPairCount() const { return pairs_; }
     /// Candidate-list rebuilds so far.
     long listBuilds() const { return builds_; }
+    /// Particles the last build searched (the rest were certified apart from anything not
+    /// bonded to them at rest).
+    int lastSearched() const { return lastActive_; }
 
 private:
     /// Moves particle i out of one surface (signed distance `s` at x, outward normal) and applies
@@ -106,6 +115,9 @@ private:
     void setUpTriangles(std::span<const std::array<int, 3>> triangles,
                         std::span<const Eigen::Vector3d> rest, double reach);
     bool listStale(std::span<const Eigen::Vector3d> x) const;
+    /// The list's guarantee under the affine motion fitted since the build (see listStale).
+    bool staleAfterAffineFit(std::span<const Eigen::Vector3d> x, const Eigen::Vector3d& mean) const;
+    void fitBuiltPositions();
     void sizeNextSkin();
     void buildList(const SheetState& s);
     /// Candidates of particle i within `reach`, appended to out (ascending bucket, triangle).
@@ -136,11 +148,20 @@ private:
     /// beyond which no corner, is bonded to a particle: one test decides most triangles.
     std::vector<Eigen::Vector3d> restCentres_;
     double allBonded2_ = 0.0, noneBonded2_ = 0.0;
-    double skin_ = 0.0;
+    double skin_ = 0.0, skinCap_ = 0.0;
+    /// Finds the parts of the sheet a build has to search (ContactCulling.h).
+    std::optional<ContactCulling> culling_;
+    int lastActive_ = 0;                            ///< particles searched at the last build
     long evaluations_ = 0, builtAtEvaluation_ = 0;  ///< force evaluations: all, at the last build
     std::vector<Eigen::Vector3d> builtAt_;          ///< positions at the last build
+    /// The build positions' centre, and the pseudo-inverse of their scatter matrix with an
+    /// orthonormal basis of the directions it spans (a flat sheet spans two).
+    Eigen::Vector3d builtCentre_ = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d builtScatterInverse_ = Eigen::Matrix3d::Zero();
+    Eigen::MatrixXd builtSpan_;
     std::vector<int> listStart_, list_;
-    std::vector<PointContact> contacts_;  ///< per particle, this evaluation's
+    std::vector<int> listed_;             ///< the particles whose lists are not empty, ascending
+    std::vector<PointContact> contacts_;  ///< per listed particle, this evaluation's
     std::size_t pairs_ = 0;
     long builds_ = 0;
 };

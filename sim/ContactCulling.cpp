@@ -1,0 +1,337 @@
+#include "sim/ContactCulling.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "sim/ColliderDistance.h"
+#include "sim/Parallel.h"
+#include "sim/PointHash.h"
+
+namespace rend::sim {
+namespace {
+
+using Cell = std::tuple<int, int, int>;
+
+/// A neighbourhood's direction whose spread at rest is below this fraction of its widest is left
+/// out of its fit.
+constexpr double kThinSpan = 0.1;
+/// Two particles of the lattices rend builds (hexagonal, square with diagonals, the geodesic
+/// sphere) are joined by a path of triangle edges at most this times their rest distance long
+/// (the square lattice's worst case, across its diagonals).
+constexpr double kEdgePath = 1.4142135623730951;
+
+Cell cellOf(const Eigen::Vector3d& x, double size) {
+    const Eigen::Vector3i c = (x / size).array().floor().cast<int>();
+    return {c.x(), c.y(), c.z()};
+}
+
+}  // namespace
+
+ContactCulling::ContactCulling(std::span<const Eigen::Vector3d> rest,
+                               std::span<const std::array<int, 3>> triangles, double bondReach2,
+                               double tileSize) {
+    if (!rest.empty()) restOrigin_ = rest[0];
+    rest_.reserve(rest.size());
+    for (const Eigen::Vector3d& p : rest) rest_.push_back(p - restOrigin_);
+    setUpTiles(rest_, tileSize);
+    measureRestClearance(rest_, bondReach2);
+    measureTriangleClearance(rest_, triangles, bondReach2);
+    setUpEdges(triangles);
+}
+
+void ContactCulling::setUpEdges(std::span<const std::array<int, 3>> triangles) {
+    std::vector<std::vector<int>> touching(tiles_.size());  // triangles with a corner in a tile
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+        for (const int c : triangles[t]) {
+            std::vector<int>& list = touching[std::size_t(tileOf_[std::size_t(c)])];
+            if (list.empty() || list.back() != int(t)) list.push_back(int(t));
+        }
+    for (Tile& tile : tiles_) {
+        for (const int b : tile.beside)
+            for (const int t : touching[std::size_t(b)]) {
+                const auto& tri = triangles[std::size_t(t)];
+                for (int k = 0; k < 3; ++k)
+                    tile.edges.push_back(
+                        {std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])});
+            }
+        std::sort(tile.edges.begin(), tile.edges.end());
+        tile.edges.erase(std::unique(tile.edges.begin(), tile.edges.end()), tile.edges.end());
+    }
+}
+
+void ContactCulling::setUpTiles(std::span<const Eigen::Vector3d> rest, double tileSize) {
+    std::map<Cell, int> index;
+    for (std::size_t i = 0; i < rest.size(); ++i) {
+        const auto [at, added] = index.try_emplace(cellOf(rest[i], tileSize), int(tiles_.size()));
+        if (added) tiles_.emplace_back();
+        tiles_[std::size_t(at->second)].particles.push_back(int(i));
+        tileOf_.push_back(at->second);
+    }
+    for (const auto& [cell, t] : index) {
+        Tile& tile = tiles_[std::size_t(t)];
+        const auto [cx, cy, cz] = cell;
+        for (int z = -1; z <= 1; ++z)
+            for (int y = -1; y <= 1; ++y)
+                for (int x = -1; x <= 1; ++x)
+                    if (const auto it = index.find({cx + x, cy + y, cz + z}); it != index.end())
+                        tile.beside.push_back(it->second);
+        std::sort(tile.beside.begin(), tile.beside.end());
+    }
+    for (Tile& tile : tiles_) {
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        for (const int b : tile.beside)
+            for (const int i : tiles_[std::size_t(b)].particles) {
+                tile.restCentre += rest[std::size_t(i)];
+                ++tile.count;
+            }
+        tile.restCentre /= double(tile.count);
+        for (const int b : tile.beside)
+            for (const int i : tiles_[std::size_t(b)].particles) {
+                const Eigen::Vector3d c = rest[std::size_t(i)] - tile.restCentre;
+                scatter += c * c.transpose();
+            }
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+        const double largest = eigen.eigenvalues().maxCoeff();
+        std::vector<Eigen::Vector3d> span;
+        for (int k = 0; k < 3; ++k) {
+            const double lambda = eigen.eigenvalues()[k];
+            // A direction the neighbourhood hardly spans (a flat sheet's seeded jitter) is left
+            // out of the fit; its extent shortens the rest clearance instead (clearance).
+            if (!(largest > 0.0) || lambda <= kThinSpan * kThinSpan * largest) continue;
+            const Eigen::Vector3d q = eigen.eigenvectors().col(k);
+            tile.restInverse += q * q.transpose() / lambda;
+            span.push_back(q);
+        }
+        tile.span.resize(3, Eigen::Index(span.size()));
+        for (std::size_t k = 0; k < span.size(); ++k) tile.span.col(Eigen::Index(k)) = span[k];
+        const Eigen::Matrix3d across =
+            Eigen::Matrix3d::Identity() - tile.span * tile.span.transpose();
+        for (const int b : tile.beside)
+            for (const int i : tiles_[std::size_t(b)].particles)
+                tile.outOfSpan = std::max(
+                    tile.outOfSpan, (across * (rest[std::size_t(i)] - tile.restCentre)).norm());
+    }
+}
+
+// The least rest distance between particles not bonded at rest, searched within twice the bond
+// reach (farther pairs are at least that far apart, so the search's radius bounds it).
+void ContactCulling::measureRestClearance(std::span<const Eigen::Vector3d> rest,
+                                          double bondReach2) {
+    const double radius = 2.0 * std::sqrt(bondReach2);
+    const PointHash hash(rest, radius);
+    const int n = int(rest.size());
+    double least = radius * radius;
+#pragma omp parallel for schedule(static) reduction(min : least) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i)
+        hash.near(rest[std::size_t(i)], [&](int j) {
+            const double r2 = (rest[std::size_t(i)] - rest[std::size_t(j)]).squaredNorm();
+            if (r2 > bondReach2) least = std::min(least, r2);
+        });
+    restClearance_ = std::sqrt(least);
+}
+
+// Lowered to the least rest distance from a particle to a triangle none of whose corners is
+// bonded to it (on a hexagonal lattice the same as between particles; the triangles only need
+// searching up to the particles' clearance).
+void ContactCulling::measureTriangleClearance(std::span<const Eigen::Vector3d> rest,
+                                              std::span<const std::array<int, 3>> triangles,
+                                              double bondReach2) {
+    std::vector<Eigen::Vector3d> centres(triangles.size());
+    double widest = 0.0;
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const auto& [a, b, c] = triangles[t];
+        centres[t] = (rest[std::size_t(a)] + rest[std::size_t(b)] + rest[std::size_t(c)]) / 3.0;
+        for (const int k : triangles[t])
+            widest = std::max(widest, (rest[std::size_t(k)] - centres[t]).norm());
+    }
+    if (centres.empty()) return;
+    const PointHash hash(centres, restClearance_ + widest);
+    const int n = int(rest.size());
+    double least = restClearance_ * restClearance_;
+#pragma omp parallel for schedule(static) reduction(min : least) if (n >= kParallelThreshold)
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d& p = rest[std::size_t(i)];
+        hash.near(p, [&](int t) {
+            const auto& tri = triangles[std::size_t(t)];
+            for (const int k : tri)
+                if ((p - rest[std::size_t(k)]).squaredNorm() <= bondReach2) return;
+            const Eigen::Vector3d &a = rest[std::size_t(tri[0])], &b = rest[std::size_t(tri[1])],
+                                  &c = rest[std::size_t(tri[2])];
+            least = std::min(least, (p - closestOnTriangle(p, a, b, c).at(a, b, c)).squaredNorm());
+        });
+    }
+    restClearance_ = std::sqrt(least);
+}
+
+// Per tile, the longest edge of the kept triangles with a corner in it: every point of such a
+// triangle is within it of each of its corners.
+std::vector<double> ContactCulling::longestEdges(std::span<const Eigen::Vector3d> x,
+                                                 std::span<const std::array<int, 3>> triangles,
+                                                 std::span<const std::uint8_t> kept) const {
+    std::vector<double> reach2(tiles_.size(), 0.0);
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        if (!kept.empty() && !kept[t]) continue;
+        const auto& [a, b, c] = triangles[t];
+        const double longest = std::max({(x[std::size_t(a)] - x[std::size_t(b)]).squaredNorm(),
+                                         (x[std::size_t(b)] - x[std::size_t(c)]).squaredNorm(),
+                                         (x[std::size_t(c)] - x[std::size_t(a)]).squaredNorm()});
+        for (const int corner : triangles[t]) {
+            double& r2 = reach2[std::size_t(tileOf_[std::size_t(corner)])];
+            r2 = std::max(r2, longest);
+        }
+    }
+    for (double& r : reach2) r = std::sqrt(r);
+    return reach2;
+}
+
+int ContactCulling::mark(std::span<const Eigen::Vector3d> x, double reach,
+                         std::span<const std::array<int, 3>> triangles,
+                         std::span<const std::uint8_t> kept,
+                         std::vector<std::uint8_t>& active) const {
+    const int tiles = int(tiles_.size());
+    const std::vector<double> edge = longestEdges(x, triangles, kept);
+    const Eigen::Vector3d origin = x.empty() ? Eigen::Vector3d::Zero() : x[0];
+    std::vector<Moments> moments(tiles_.size());
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int t = 0; t < tiles; ++t) {
+        Moments& m = moments[std::size_t(t)];
+        for (const int i : tiles_[std::size_t(t)].particles) {
+            const Eigen::Vector3d p = x[std::size_t(i)] - origin;
+            m.sum += p;
+            m.cross += p * rest_[std::size_t(i)].transpose();
+        }
+    }
+    std::vector<std::uint8_t> tileActive(std::size_t(tiles), 0);
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int t = 0; t < tiles; ++t)
+        tileActive[std::size_t(t)] = !smooth(tiles_[std::size_t(t)], moments, x, reach);
+    markOverlaps(x, reach, edge, tileActive);
+    // What the search lists for: the active tiles' particles (1); the triangles it lists from
+    // have a corner in an active tile or one beside it (2).
+    active.assign(x.size(), 0);
+    int count = 0;
+    for (int t = 0; t < tiles; ++t) {
+        if (!tileActive[std::size_t(t)]) continue;
+        for (const int b : tiles_[std::size_t(t)].beside)
+            for (const int i : tiles_[std::size_t(b)].particles)
+                active[std::size_t(i)] = std::max<std::uint8_t>(active[std::size_t(i)], 2);
+        count += int(tiles_[std::size_t(t)].particles.size());
+    }
+    for (int t = 0; t < tiles; ++t)
+        if (tileActive[std::size_t(t)])
+            for (const int i : tiles_[std::size_t(t)].particles) active[std::size_t(i)] = 1;
+    return count;
+}
+
+// The neighbourhood's affine fit x = centre + F (X - restCentre) + r: quiet when
+// sigma restClearance - 2 max|r| >= reach.
+bool ContactCulling::smooth(const Tile& tile, std::span<const Moments> moments,
+                            std::span<const Eigen::Vector3d> x, double reach) const {
+    if (tile.span.cols() == 0) return true;  // a single particle
+    Moments sum;
+    for (const int b : tile.beside) {
+        sum.sum += moments[std::size_t(b)].sum;
+        sum.cross += moments[std::size_t(b)].cross;
+    }
+    const Eigen::Vector3d centre = sum.sum / double(tile.count);
+    const Eigen::Matrix3d f =
+        (sum.cross - double(tile.count) * centre * tile.restCentre.transpose()) * tile.restInverse;
+    const Eigen::MatrixXd image = f * tile.span;
+    const Eigen::MatrixXd gram = image.transpose() * image;
+    const double sigma = std::sqrt(
+        std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gram, Eigen::EigenvaluesOnly)
+                          .eigenvalues()
+                          .minCoeff()));
+    // Two rest points of the neighbourhood restClearance apart are at least clearance apart
+    // within its span.
+    const double outOfSpan = 2.0 * tile.outOfSpan;
+    const double clearance =
+        std::sqrt(std::max(0.0, restClearance_ * restClearance_ - outOfSpan * outOfSpan));
+    const double allowed = 0.5 * (sigma * clearance - reach);  // on max|r|
+    if (allowed <= 0.0) return false;                          // no residual bound can pass either
+    // A sheet's neighbourhood maps onto a plane: residuals across it (waves, jitter, a gentle
+    // bend) only move points apart, |x_i - x_j|^2 = |F dX + dr_along|^2 + dr_across^2, so only
+    // the part along the plane counts.
+    Eigen::Matrix3d along = Eigen::Matrix3d::Identity();
+    if (image.cols() == 2) {
+        const Eigen::Vector3d normal =
+            Eigen::Vector3d(image.col(0)).cross(Eigen::Vector3d(image.col(1))).normalized();
+        along -= normal * normal.transpose();
+    }
+    const Eigen::Vector3d origin = x[0];
+    bool within = true;
+    for (std::size_t b = 0; within && b < tile.beside.size(); ++b)
+        for (const int i : tiles_[std::size_t(tile.beside[b])].particles) {
+            const Eigen::Vector3d r =
+                x[std::size_t(i)] - origin - centre - f * (rest_[std::size_t(i)] - tile.restCentre);
+            if ((along * r).squaredNorm() > allowed * allowed) {
+                within = false;
+                break;
+            }
+        }
+    return within || (sigma - kEdgePath * residualSlope(tile, x, f, along)) * clearance >= reach;
+}
+
+double ContactCulling::residualSlope(const Tile& tile, std::span<const Eigen::Vector3d> x,
+                                     const Eigen::Matrix3d& f, const Eigen::Matrix3d& along) const {
+    double slope = 0.0;  // squared
+    for (const auto& [a, b] : tile.edges) {
+        const Eigen::Vector3d restEdge = rest_[std::size_t(a)] - rest_[std::size_t(b)];
+        const Eigen::Vector3d change =
+            along * (x[std::size_t(a)] - x[std::size_t(b)] - f * restEdge);
+        slope = std::max(slope, change.squaredNorm() / restEdge.squaredNorm());
+    }
+    return std::sqrt(slope);
+}
+
+// Tiles not beside each other at rest, by bounding spheres about their particles' mean.
+void ContactCulling::markOverlaps(std::span<const Eigen::Vector3d> x, double reach,
+                                  std::span<const double> edge,
+                                  std::vector<std::uint8_t>& tileActive) const {
+    const int tiles = int(tiles_.size());
+    std::vector<Eigen::Vector3d> centres(tiles_.size());
+    std::vector<double> radii(std::size_t(tiles), 0.0);
+    for (int t = 0; t < tiles; ++t) {
+        const std::vector<int>& own = tiles_[std::size_t(t)].particles;
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (const int i : own) c += x[std::size_t(i)];
+        c /= double(own.size());
+        double r2 = 0.0;
+        for (const int i : own) r2 = std::max(r2, (x[std::size_t(i)] - c).squaredNorm());
+        centres[std::size_t(t)] = c;
+        radii[std::size_t(t)] = std::sqrt(r2);
+    }
+    const double widest = tiles > 0 ? *std::max_element(radii.begin(), radii.end()) : 0.0;
+    const double longest = tiles > 0 ? *std::max_element(edge.begin(), edge.end()) : 0.0;
+    const PointHash hash(centres, 2.0 * widest + reach + longest);
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int t = 0; t < tiles; ++t) {
+        if (tileActive[std::size_t(t)]) continue;
+        const std::vector<int>& beside = tiles_[std::size_t(t)].beside;
+        hash.near(centres[std::size_t(t)], [&](int u) {
+            if (tileActive[std::size_t(t)] || std::binary_search(beside.begin(), beside.end(), u))
+                return;
+            const double gap = reach + std::max(edge[std::size_t(t)], edge[std::size_t(u)]);
+            const double apart = radii[std::size_t(t)] + radii[std::size_t(u)] + gap;
+            if ((centres[std::size_t(t)] - centres[std::size_t(u)]).squaredNorm() >= apart * apart)
+                return;
+            // The spheres meet: the particles themselves (the same test from either tile).
+            const double toSphere = radii[std::size_t(u)] + gap;
+            for (const int i : tiles_[std::size_t(t)].particles) {
+                if ((x[std::size_t(i)] - centres[std::size_t(u)]).squaredNorm() >=
+                    toSphere * toSphere)
+                    continue;
+                for (const int j : tiles_[std::size_t(u)].particles)
+                    if ((x[std::size_t(i)] - x[std::size_t(j)]).squaredNorm() < gap * gap) {
+                        tileActive[std::size_t(t)] = 1;
+                        return;
+                    }
+            }
+        });
+    }
+}
+
+}  // namespace rend::sim

@@ -1,0 +1,203 @@
+// Self-contact's culling (sim/ContactCulling.h) and candidate list (sim/Contact.h) against brute
+// force: whatever the sheet's shape, nothing within reach of a particle and not bonded to it at
+// rest is left out, and a smooth sheet is left out of the search.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "sim/ColliderDistance.h"
+#include "sim/Contact.h"
+#include "sim/ContactCulling.h"
+#include "sim/Lattice.h"
+
+using namespace rend::sim;
+
+namespace {
+
+constexpr double kDx = 0.01;
+const double kBondReach = 1.5 * kDx * (1.0 + 1e-9);
+
+struct Sheet {
+    Lattice lattice;
+    std::span<const Eigen::Vector3d> rest() const { return lattice.positions; }
+};
+
+Sheet makeSheet(LatticeKind kind, Eigen::Vector2d size) {
+    SheetParams p;
+    p.size = size;
+    p.dx = kDx;
+    p.lattice = kind;
+    return {generateLattice(p)};
+}
+
+bool bonded(const Sheet& s, int i, int j) {
+    return (s.rest()[std::size_t(i)] - s.rest()[std::size_t(j)]).squaredNorm() <=
+           kBondReach * kBondReach;
+}
+
+/// Every particle pair and particle-triangle pair within reach and not bonded at rest involves
+/// particles marked 1 and a triangle with a marked corner (ContactCulling::mark's contract).
+void expectContract(const Sheet& s, std::span<const Eigen::Vector3d> x, double reach,
+                    const std::vector<std::uint8_t>& active) {
+    const int n = int(x.size());
+    int missed = 0;
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j)
+            if (j != i && !bonded(s, i, j) && (x[i] - x[j]).norm() < reach && active[i] != 1)
+                ++missed;
+        for (const auto& tri : s.lattice.triangles) {
+            if (bonded(s, i, tri[0]) || bonded(s, i, tri[1]) || bonded(s, i, tri[2])) continue;
+            const TrianglePoint c = closestOnTriangle(x[i], x[tri[0]], x[tri[1]], x[tri[2]]);
+            if ((x[i] - c.at(x[tri[0]], x[tri[1]], x[tri[2]])).norm() >= reach) continue;
+            if (active[i] != 1 || (!active[tri[0]] && !active[tri[1]] && !active[tri[2]])) ++missed;
+        }
+    }
+    EXPECT_EQ(missed, 0);
+}
+
+using Deform = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
+
+std::vector<Eigen::Vector3d> deformed(const Sheet& s, const Deform& f) {
+    std::vector<Eigen::Vector3d> x;
+    for (const Eigen::Vector3d& p : s.rest()) x.push_back(f(p));
+    return x;
+}
+
+}  // namespace
+
+TEST(ContactCulling, RestClearanceIsTheNearestUnbondedParticleOrTriangle) {
+    const Sheet hex = makeSheet(LatticeKind::Hexagonal, {0.2, 0.2});
+    const ContactCulling h(hex.rest(), hex.lattice.triangles, kBondReach * kBondReach,
+                           3 * kBondReach);
+    EXPECT_NEAR(h.restClearance(), std::sqrt(3.0) * kDx, 1e-9);  // the second shell
+    const Sheet square = makeSheet(LatticeKind::Square, {0.2, 0.2});
+    const ContactCulling q(square.rest(), square.lattice.triangles, kBondReach * kBondReach,
+                           3 * kBondReach);
+    // Particles two apart along a row are the nearest unbonded ones (2 dx), but a diagonal of a
+    // cell whose corners are all unbonded passes nearer.
+    EXPECT_GT(q.restClearance(), kBondReach);
+    EXPECT_LE(q.restClearance(), 2.0 * kDx + 1e-12);
+}
+
+TEST(ContactCulling, SmoothSheetsAreLeftOut) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.3, 0.3});
+    const ContactCulling culling(s.rest(), s.lattice.triangles, kBondReach * kBondReach,
+                                 3 * kBondReach);
+    const double reach = 0.8 * kDx;
+    const std::vector<std::pair<const char*, Deform>> shapes = {
+        {"flat", [](const Eigen::Vector3d& p) -> Eigen::Vector3d { return p; }},
+        {"moved and turned",
+         [](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+             return Eigen::Vector3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) *
+                                    p) +
+                    Eigen::Vector3d(5, -3, 2);
+         }},
+        {"stretched 40% and drawn in 10%",
+         [](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+             return Eigen::Vector3d(1.4 * p.x(), 0.9 * p.y(), p.z());
+         }},
+        {"rolled on a cylinder of 40 dx",
+         [](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+             const double r = 40 * kDx, a = p.x() / r;
+             return Eigen::Vector3d(r * std::sin(a), p.y(), r * (1 - std::cos(a)));
+         }},
+        {"wavy, 2 dx high over 30 dx",
+         [](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+             return Eigen::Vector3d(p.x(), p.y(), 2 * kDx * std::sin(p.x() / (30 * kDx / 6.283)));
+         }},
+    };
+    for (const auto& [name, shape] : shapes) {
+        std::vector<std::uint8_t> active;
+        const std::vector<Eigen::Vector3d> x = deformed(s, shape);
+        EXPECT_EQ(culling.mark(x, reach, s.lattice.triangles, {}, active), 0) << name;
+    }
+}
+
+// Folds, crumples and torn-off flaps laid back on the sheet: the contract holds, and the fold is
+// found. Random crumples of several strengths look for a pair the tests miss.
+TEST(ContactCulling, NothingWithinReachIsLeftOut) {
+    for (const LatticeKind kind : {LatticeKind::Hexagonal, LatticeKind::Square}) {
+        const Sheet s = makeSheet(kind, {0.24, 0.16});
+        const ContactCulling culling(s.rest(), s.lattice.triangles, kBondReach * kBondReach,
+                                     3 * kBondReach);
+        const double reach = 0.9 * kDx;
+        // Folded over at x = 0.03 onto itself, the layers 0.6 dx apart.
+        const Deform fold = [](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+            if (p.x() < 0.03) return p;
+            const double r = 0.3 * kDx, a = std::min((p.x() - 0.03) / r, M_PI);
+            const double beyond = std::max(0.0, p.x() - 0.03 - M_PI * r);
+            return Eigen::Vector3d(0.03 + r * std::sin(a) - beyond, p.y(), r * (1 - std::cos(a)));
+        };
+        std::vector<std::uint8_t> active;
+        std::vector<Eigen::Vector3d> x = deformed(s, fold);
+        EXPECT_GT(culling.mark(x, reach, s.lattice.triangles, {}, active), 0);
+        expectContract(s, x, reach, active);
+        std::mt19937 random(7);
+        for (const double strength : {0.2, 0.5, 1.0, 2.0}) {
+            std::normal_distribution<double> noise(0.0, strength * kDx);
+            const double k = 2 * M_PI / (6 * kDx);
+            const Eigen::Vector3d phase(noise(random), noise(random), noise(random));
+            const Deform crumple = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                return Eigen::Vector3d(
+                    p.x() + strength * kDx * std::sin(k * p.y() + phase.x()),
+                    0.6 * p.y() + strength * kDx * std::sin(k * p.x() + phase.y()),
+                    strength * 2 * kDx * std::sin(k * (p.x() + p.y()) + phase.z()) +
+                        0.3 * noise(random));
+            };
+            x = deformed(s, crumple);
+            culling.mark(x, reach, s.lattice.triangles, {}, active);
+            expectContract(s, x, reach, active);
+        }
+    }
+}
+
+// The candidate list, kept across evaluations while the sheet stretches, bends and folds, finds
+// every contact brute force finds: lastPairCount counts each particle's nearest triangle within
+// d and its particles within d.
+TEST(ContactCulling, TheListFindsEveryContactAsTheSheetMoves) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
+    ContactParams params;
+    params.self.enabled = true;
+    const double d = 0.5 * kDx;
+    Contact contact(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+    const int n = int(s.rest().size());
+    const std::vector<double> mass(std::size_t(n), 1.0);
+    const std::vector<Eigen::Vector3d> v(std::size_t(n), Eigen::Vector3d::Zero());
+    for (int frame = 0; frame <= 60; ++frame) {
+        const double t = frame / 60.0;
+        // Stretched along x by up to 30%, then folded over at x = 0.02 by up to 180 degrees.
+        const double stretch = 1.0 + 0.3 * std::min(1.0, 2 * t);
+        const double angle = M_PI * std::max(0.0, 2 * t - 1.0);
+        const std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                Eigen::Vector3d q(stretch * p.x(), p.y(), p.z());
+                if (q.x() <= 0.02) return q;
+                const double r = 0.2 * kDx, a = std::min((q.x() - 0.02) / r, angle);
+                const double beyond = q.x() - 0.02 - a * r;
+                const Eigen::Vector3d bend(0.02 + r * std::sin(a), q.y(), r * (1 - std::cos(a)));
+                return Eigen::Vector3d(bend +
+                                       beyond * Eigen::Vector3d(std::cos(a), 0, std::sin(a)));
+            });
+        std::vector<Eigen::Vector3d> force(std::size_t(n), Eigen::Vector3d::Zero());
+        contact.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, force);
+        std::size_t expected = 0;
+        for (int i = 0; i < n; ++i) {
+            for (int j = 0; j < n; ++j)
+                if (j != i && !bonded(s, i, j) && (x[i] - x[j]).squaredNorm() < d * d) ++expected;
+            for (const auto& tri : s.lattice.triangles) {
+                if (bonded(s, i, tri[0]) || bonded(s, i, tri[1]) || bonded(s, i, tri[2])) continue;
+                const TrianglePoint c = closestOnTriangle(x[i], x[tri[0]], x[tri[1]], x[tri[2]]);
+                if ((x[i] - c.at(x[tri[0]], x[tri[1]], x[tri[2]])).squaredNorm() < d * d) {
+                    ++expected;
+                    break;
+                }
+            }
+        }
+        ASSERT_EQ(contact.lastPairCount(), expected) << "frame " << frame;
+    }
+    EXPECT_GT(contact.lastPairCount(), 0u);  // the fold closed
+    EXPECT_LT(contact.listBuilds(), 45);     // the stretch kept its list
+}

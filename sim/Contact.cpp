@@ -34,7 +34,7 @@ constexpr long kListSteps = 24;
 /// told apart by their bounding spheres, narrow enough that a gently bent sheet fits an affine
 /// map over three of them.
 constexpr double kTileSize = 3.0;
-constexpr double kCullingReach = 0.5;
+constexpr double kCullingReach = 0.6;
 
 Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
     return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
@@ -315,28 +315,51 @@ void Contact::buildList(const SheetState& s) {
         }
     const PointHash hash(centres, reach + widest);
     const PointHash points(searchedAt, reach);
+    // What a query reads of each item, in the hashes' own order: read in sequence, not gathered
+    // from the whole sheet's arrays.
+    struct TriangleItem {
+        Eigen::Vector3d restCentre, centre;
+        double radius;
+        int triangle;
+    };
+    struct ParticleItem {
+        Eigen::Vector3d rest;
+        int particle;
+    };
+    std::vector<TriangleItem> triangleItems(centres.size());
+    for (std::size_t slot = 0; slot < centres.size(); ++slot) {
+        const std::size_t k = std::size_t(hash.item(int(slot)));
+        const int t = kept[k];
+        triangleItems[slot] = {restCentres_[std::size_t(t)], centres[k], radii[k], t};
+    }
+    std::vector<ParticleItem> particleItems(searched.size());
+    for (std::size_t slot = 0; slot < searched.size(); ++slot) {
+        const int j = searched[std::size_t(points.item(int(slot)))];
+        particleItems[slot] = {s.rest[j], j};
+    }
     const auto triangleCandidates = [&](int i, std::vector<std::pair<int, int>>& out) {
-        hash.near(s.x[i], [&](int k) {
-            const int t = kept[std::size_t(k)];
-            const auto& tri = triangles_[std::size_t(t)];
-            const double near = reach + radii[std::size_t(k)];  // a bound on its distance
-            if ((s.x[i] - centres[std::size_t(k)]).squaredNorm() >= near * near) return;
-            const double fromRest = (s.rest[i] - restCentres_[std::size_t(t)]).squaredNorm();
-            if (fromRest <= allBonded2_) return;  // every corner within the horizon
+        hash.nearSlots(s.x[i], [&](int slot) {
+            const TriangleItem& item = triangleItems[std::size_t(slot)];
+            const double fromRest = (s.rest[i] - item.restCentre).squaredNorm();
+            if (fromRest <= allBonded2_) return;      // every corner within the horizon
+            const double near = reach + item.radius;  // a bound on its distance
+            if ((s.x[i] - item.centre).squaredNorm() >= near * near) return;
+            const auto& tri = triangles_[std::size_t(item.triangle)];
             if (fromRest <= noneBonded2_ && bondedAtRest(i, tri, s.rest)) return;
             const TrianglePoint c =
                 closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
             if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
                 reach * reach)
-                out.emplace_back(i, t);
+                out.emplace_back(i, item.triangle);
         });
     };
     const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
         triangleCandidates(i, out);
-        points.near(s.x[i], [&](int k) {
-            const int j = searched[std::size_t(k)];
-            if (j == i || (s.rest[i] - s.rest[j]).squaredNorm() <= restExclusion2_) return;
-            out.emplace_back(i, -(j + 1));  // a particle: negative
+        points.nearSlots(s.x[i], [&](int slot) {
+            const ParticleItem& item = particleItems[std::size_t(slot)];
+            if (item.particle == i || (s.rest[i] - item.rest).squaredNorm() <= restExclusion2_)
+                return;
+            out.emplace_back(i, -(item.particle + 1));  // a particle: negative
         });
     };
     std::vector<std::vector<std::pair<int, int>>> found;

@@ -154,6 +154,35 @@ TEST(ContactCulling, NothingWithinReachIsLeftOut) {
     }
 }
 
+// Smooth in-plane squeezes that vary across a tile's neighbourhood (the shape the edge-path
+// bound passes or fails), some bringing unbonded particles within reach, at random.
+TEST(ContactCulling, UnevenSqueezesLeaveNothingOut) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.14});
+    const ContactCulling culling(s.rest(), s.lattice.triangles, kBondReach * kBondReach,
+                                 3 * kBondReach);
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    int searched = 0, quiet = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const double k = 2 * M_PI / ((4 + 16 * uniform(random)) * kDx);
+        const double depth = 0.3 + 0.6 * uniform(random), phase = 6.3 * uniform(random);
+        const double reach = (0.6 + 0.4 * uniform(random)) * kDx;
+        // x' = x - depth sin(k x + phase) / k: the stretch 1 - depth cos(k x + phase) runs from
+        // 1 - depth to 1 + depth across a wavelength.
+        const std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                return {p.x() - depth * std::sin(k * p.x() + phase) / k, p.y(), p.z()};
+            });
+        std::vector<std::uint8_t> active;
+        const int marked = culling.mark(x, reach, s.lattice.triangles, {}, active);
+        searched += marked > 0;
+        quiet += marked < int(x.size());
+        expectContract(s, x, reach, active);
+    }
+    EXPECT_GT(searched, 0);
+    EXPECT_GT(quiet, 0);
+}
+
 // The candidate list, kept across evaluations while the sheet stretches, bends and folds, finds
 // every contact brute force finds: lastPairCount counts each particle's nearest triangle within
 // d and its particles within d.

@@ -1,6 +1,7 @@
 #include "sim/ContactCulling.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -18,6 +19,9 @@ using Cell = std::tuple<int, int, int>;
 /// A neighbourhood's direction whose spread at rest is below this fraction of its widest is left
 /// out of its fit.
 constexpr double kThinSpan = 0.1;
+/// A tile whose bounding sphere or longest edge has grown past this many times its rest size is
+/// handled by its box (markNearBigTiles), not by the spheres' hash.
+constexpr double kBigTile = 2.0;
 /// Two particles of the lattices rend builds (hexagonal, square with diagonals, the geodesic
 /// sphere) are joined by a path of triangle edges at most this times their rest distance long
 /// (the square lattice's worst case, across its diagonals).
@@ -49,6 +53,11 @@ void ContactCulling::setUpEdges(std::span<const std::array<int, 3>> triangles) {
             std::vector<int>& list = touching[std::size_t(tileOf_[std::size_t(c)])];
             if (list.empty() || list.back() != int(t)) list.push_back(int(t));
         }
+    for (const auto& tri : triangles)
+        for (int k = 0; k < 3; ++k)
+            restEdge_ = std::max(
+                restEdge_,
+                (rest_[std::size_t(tri[k])] - rest_[std::size_t(tri[(k + 1) % 3])]).norm());
     for (Tile& tile : tiles_) {
         for (const int b : tile.beside)
             for (const int t : touching[std::size_t(b)]) {
@@ -69,6 +78,13 @@ void ContactCulling::setUpTiles(std::span<const Eigen::Vector3d> rest, double ti
         if (added) tiles_.emplace_back();
         tiles_[std::size_t(at->second)].particles.push_back(int(i));
         tileOf_.push_back(at->second);
+    }
+    for (Tile& tile : tiles_) {
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (const int i : tile.particles) c += rest[std::size_t(i)];
+        c /= double(tile.particles.size());
+        for (const int i : tile.particles)
+            restRadius_ = std::max(restRadius_, (rest[std::size_t(i)] - c).norm());
     }
     for (const auto& [cell, t] : index) {
         Tile& tile = tiles_[std::size_t(t)];
@@ -304,34 +320,79 @@ void ContactCulling::markOverlaps(std::span<const Eigen::Vector3d> x, double rea
         centres[std::size_t(t)] = c;
         radii[std::size_t(t)] = std::sqrt(r2);
     }
-    const double widest = tiles > 0 ? *std::max_element(radii.begin(), radii.end()) : 0.0;
-    const double longest = tiles > 0 ? *std::max_element(edge.begin(), edge.end()) : 0.0;
-    const PointHash hash(centres, 2.0 * widest + reach + longest);
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    // A tile torn apart or stretched far beyond its rest size would widen every query; those
+    // few are made active with every tile near their box instead.
+    const double radiusCap = kBigTile * restRadius_, edgeCap = kBigTile * restEdge_;
+    std::vector<int> small, big;
+    std::vector<Eigen::Vector3d> smallCentres;
     for (int t = 0; t < tiles; ++t) {
+        if (radii[std::size_t(t)] > radiusCap || edge[std::size_t(t)] > edgeCap) {
+            big.push_back(t);
+            continue;
+        }
+        small.push_back(t);
+        smallCentres.push_back(centres[std::size_t(t)]);
+    }
+    const PointHash hash(smallCentres, 2.0 * radiusCap + reach + edgeCap);
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int k = 0; k < int(small.size()); ++k) {
+        const int t = small[std::size_t(k)];
         if (tileActive[std::size_t(t)]) continue;
         const std::vector<int>& beside = tiles_[std::size_t(t)].beside;
-        hash.near(centres[std::size_t(t)], [&](int u) {
+        hash.near(centres[std::size_t(t)], [&](int item) {
+            const int u = small[std::size_t(item)];
             if (tileActive[std::size_t(t)] || std::binary_search(beside.begin(), beside.end(), u))
                 return;
             const double gap = reach + std::max(edge[std::size_t(t)], edge[std::size_t(u)]);
-            const double apart = radii[std::size_t(t)] + radii[std::size_t(u)] + gap;
-            if ((centres[std::size_t(t)] - centres[std::size_t(u)]).squaredNorm() >= apart * apart)
-                return;
-            // The spheres meet: the particles themselves (the same test from either tile).
-            const double toSphere = radii[std::size_t(u)] + gap;
-            for (const int i : tiles_[std::size_t(t)].particles) {
-                if ((x[std::size_t(i)] - centres[std::size_t(u)]).squaredNorm() >=
-                    toSphere * toSphere)
-                    continue;
-                for (const int j : tiles_[std::size_t(u)].particles)
-                    if ((x[std::size_t(i)] - x[std::size_t(j)]).squaredNorm() < gap * gap) {
-                        tileActive[std::size_t(t)] = 1;
-                        return;
-                    }
-            }
+            if (particlesMeet(x, t, u, centres[std::size_t(t)], radii[std::size_t(t)],
+                              centres[std::size_t(u)], radii[std::size_t(u)], gap))
+                tileActive[std::size_t(t)] = 1;
         });
     }
+    markNearBigTiles(x, reach, edgeCap, edge, big, centres, radii, tileActive);
+}
+
+// Whether a particle of tile t comes within `gap` of one of tile u: the spheres first, then the
+// particles near u's sphere (the same answer from either tile).
+bool ContactCulling::particlesMeet(std::span<const Eigen::Vector3d> x, int t, int u,
+                                   const Eigen::Vector3d& centreT, double radiusT,
+                                   const Eigen::Vector3d& centreU, double radiusU,
+                                   double gap) const {
+    const double apart = radiusT + radiusU + gap;
+    if ((centreT - centreU).squaredNorm() >= apart * apart) return false;
+    const double toSphere = radiusU + gap;
+    for (const int i : tiles_[std::size_t(t)].particles) {
+        if ((x[std::size_t(i)] - centreU).squaredNorm() >= toSphere * toSphere) continue;
+        for (const int j : tiles_[std::size_t(u)].particles)
+            if ((x[std::size_t(i)] - x[std::size_t(j)]).squaredNorm() < gap * gap) return true;
+    }
+    return false;
+}
+
+void ContactCulling::markNearBigTiles(std::span<const Eigen::Vector3d> x, double reach,
+                                      double edgeCap, std::span<const double> edge,
+                                      std::span<const int> big,
+                                      std::span<const Eigen::Vector3d> centres,
+                                      std::span<const double> radii,
+                                      std::vector<std::uint8_t>& tileActive) const {
+    if (big.empty()) return;
+    std::vector<Eigen::AlignedBox3d> boxes;
+    for (const int b : big) {
+        Eigen::AlignedBox3d box;
+        for (const int i : tiles_[std::size_t(b)].particles) box.extend(x[std::size_t(i)]);
+        const double gap = reach + std::max(edge[std::size_t(b)], edgeCap);
+        box.extend(box.min() - Eigen::Vector3d::Constant(gap));
+        box.extend(box.max() + Eigen::Vector3d::Constant(gap));
+        boxes.push_back(box);
+        tileActive[std::size_t(b)] = 1;
+    }
+    const int tiles = int(tiles_.size());
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int t = 0; t < tiles; ++t)
+        for (std::size_t k = 0; !tileActive[std::size_t(t)] && k < boxes.size(); ++k)
+            if (boxes[k].squaredExteriorDistance(centres[std::size_t(t)]) <
+                radii[std::size_t(t)] * radii[std::size_t(t)])
+                tileActive[std::size_t(t)] = 1;
 }
 
 }  // namespace rend::sim

@@ -80,7 +80,17 @@ private:
     void markOverlaps(std::span<const Eigen::Vector3d> x, double reach,
                       std::span<const double> edge, std::vector<std::uint8_t>& tileActive) const;
 
+    bool particlesMeet(std::span<const Eigen::Vector3d> x, int t, int u,
+                       const Eigen::Vector3d& centreT, double radiusT,
+                       const Eigen::Vector3d& centreU, double radiusU, double gap) const;
+    void markNearBigTiles(std::span<const Eigen::Vector3d> x, double reach, double edgeCap,
+                          std::span<const double> edge, std::span<const int> big,
+                          std::span<const Eigen::Vector3d> centres, std::span<const double> radii,
+                          std::vector<std::uint8_t>& tileActive) const;
+
     std::vector<Eigen::Vector3d> rest_;  ///< relative to restOrigin_
+    double restRadius_ = 0.0;            ///< the widest tile's bounding radius at rest
+    double restEdge_ = 0.0;              ///< the longest triangle edge at rest
     Eigen::Vector3d restOrigin_ = Eigen::Vector3d::Zero();
     std::vector<Tile> tiles_;
     std::vector<int> tileOf_;  ///< per particle

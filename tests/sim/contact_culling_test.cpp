@@ -136,6 +136,15 @@ TEST(ContactCulling, NothingWithinReachIsLeftOut) {
         EXPECT_GT(culling.mark(x, reach, s.lattice.triangles, {}, active), 0);
         expectContract(s, x, reach, active);
         std::mt19937 random(7);
+        // A corner shattered: its particles thrown up to 12 dx about, some onto the sheet (tiles
+        // torn far past their rest size go by their boxes).
+        std::uniform_real_distribution<double> throwOf(-12 * kDx, 12 * kDx);
+        x = deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+            if (p.x() < 0.06 || p.y() < 0.02) return p;
+            return p + Eigen::Vector3d(throwOf(random), throwOf(random), 0.05 * throwOf(random));
+        });
+        culling.mark(x, reach, s.lattice.triangles, {}, active);
+        expectContract(s, x, reach, active);
         for (const double strength : {0.2, 0.5, 1.0, 2.0}) {
             std::normal_distribution<double> noise(0.0, strength * kDx);
             const double k = 2 * M_PI / (6 * kDx);

@@ -35,6 +35,9 @@ constexpr long kListSteps = 24;
 /// map over three of them.
 constexpr double kTileSize = 3.0;
 constexpr double kCullingReach = 0.6;
+/// A triangle whose centroid is this many times farther from a corner than the widest at rest
+/// goes into the stretched triangles' hash.
+constexpr double kStretchedTriangle = 2.0;
 
 Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
     return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
@@ -73,6 +76,7 @@ void Contact::setUpTriangles(std::span<const std::array<int, 3>> triangles,
         for (const int c : triangles_[t])
             widest = std::max(widest, (rest[c] - restCentres_[t]).norm());
     }
+    restWidest_ = widest;
     allBonded2_ = reach > widest ? (reach - widest) * (reach - widest) : -1.0;
     noneBonded2_ = (reach + widest) * (reach + widest);
     culling_.emplace(rest, triangles, reach * reach, kTileSize * reach);
@@ -275,6 +279,32 @@ bool Contact::bondedAtRest(int i, const std::array<int, 3>& tri,
     return false;
 }
 
+Contact::TriangleHash::TriangleHash(const Contact& contact, std::span<const int> which,
+                                    std::span<const Eigen::Vector3d> centres,
+                                    std::span<const double> radii, std::span<const int> kept,
+                                    double reach)
+    : hash(gather(which, centres), reach + widestOf(which, radii)) {
+    items.resize(which.size());
+    for (std::size_t slot = 0; slot < which.size(); ++slot) {
+        const std::size_t k = std::size_t(which[std::size_t(hash.item(int(slot)))]);
+        const int t = kept[k];
+        items[slot] = {contact.restCentres_[std::size_t(t)], centres[k], radii[k], t};
+    }
+}
+
+std::vector<Eigen::Vector3d> Contact::TriangleHash::gather(std::span<const int> which,
+                                                           std::span<const Eigen::Vector3d> all) {
+    std::vector<Eigen::Vector3d> some;
+    for (const int k : which) some.push_back(all[std::size_t(k)]);
+    return some;
+}
+
+double Contact::TriangleHash::widestOf(std::span<const int> which, std::span<const double> radii) {
+    double widest = 0.0;
+    for (const int k : which) widest = std::max(widest, radii[std::size_t(k)]);
+    return widest;
+}
+
 // Every kept triangle within d + skin of particle i and not bonded to it at rest, and every
 // particle within d + skin not bonded to it at rest. A particle and
 // the triangles' corners each move less than skin / 2 before the next build, so no triangle
@@ -287,9 +317,8 @@ void Contact::buildList(const SheetState& s) {
     // triangles with a corner marked 1 or 2 can be it.
     std::vector<std::uint8_t> active;
     lastActive_ = culling_->mark(s.x, reach, triangles_, s.kept, active);
-    // The kept triangles (torn ones are never touched) and the largest distance from one's
-    // centroid to its corners.
-    double widest = 0.0;
+    // The kept triangles (torn ones are never touched), their centroids and each one's largest
+    // distance from its centroid to a corner.
     std::vector<int> kept;
     std::vector<Eigen::Vector3d> centres;
     std::vector<double> radii;  // each triangle's own
@@ -304,7 +333,6 @@ void Contact::buildList(const SheetState& s) {
         double r2 = 0.0;
         for (const int c : tri) r2 = std::max(r2, (s.x[c] - centres.back()).squaredNorm());
         radii.push_back(std::sqrt(r2));
-        widest = std::max(widest, radii.back());
     }
     std::vector<int> searched;
     std::vector<Eigen::Vector3d> searchedAt;
@@ -313,45 +341,40 @@ void Contact::buildList(const SheetState& s) {
             searched.push_back(i);
             searchedAt.push_back(s.x[i]);
         }
-    const PointHash hash(centres, reach + widest);
+    // Triangles stretched far past their rest size (a rubber film about a hole) would widen
+    // every query: they get a hash of their own, with cells of their own reach.
+    std::vector<int> usual, stretched;
+    for (std::size_t k = 0; k < radii.size(); ++k)
+        (radii[k] > kStretchedTriangle * restWidest_ ? stretched : usual).push_back(int(k));
+    const TriangleHash usualHash(*this, usual, centres, radii, kept, reach);
+    const TriangleHash stretchedHash(*this, stretched, centres, radii, kept, reach);
     const PointHash points(searchedAt, reach);
-    // What a query reads of each item, in the hashes' own order: read in sequence, not gathered
-    // from the whole sheet's arrays.
-    struct TriangleItem {
-        Eigen::Vector3d restCentre, centre;
-        double radius;
-        int triangle;
-    };
+    // What a query reads of each particle, in the hash's own order.
     struct ParticleItem {
         Eigen::Vector3d rest;
         int particle;
     };
-    std::vector<TriangleItem> triangleItems(centres.size());
-    for (std::size_t slot = 0; slot < centres.size(); ++slot) {
-        const std::size_t k = std::size_t(hash.item(int(slot)));
-        const int t = kept[k];
-        triangleItems[slot] = {restCentres_[std::size_t(t)], centres[k], radii[k], t};
-    }
     std::vector<ParticleItem> particleItems(searched.size());
     for (std::size_t slot = 0; slot < searched.size(); ++slot) {
         const int j = searched[std::size_t(points.item(int(slot)))];
         particleItems[slot] = {s.rest[j], j};
     }
     const auto triangleCandidates = [&](int i, std::vector<std::pair<int, int>>& out) {
-        hash.nearSlots(s.x[i], [&](int slot) {
-            const TriangleItem& item = triangleItems[std::size_t(slot)];
-            const double fromRest = (s.rest[i] - item.restCentre).squaredNorm();
-            if (fromRest <= allBonded2_) return;      // every corner within the horizon
-            const double near = reach + item.radius;  // a bound on its distance
-            if ((s.x[i] - item.centre).squaredNorm() >= near * near) return;
-            const auto& tri = triangles_[std::size_t(item.triangle)];
-            if (fromRest <= noneBonded2_ && bondedAtRest(i, tri, s.rest)) return;
-            const TrianglePoint c =
-                closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
-            if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
-                reach * reach)
-                out.emplace_back(i, item.triangle);
-        });
+        for (const TriangleHash* h : {&usualHash, &stretchedHash})
+            h->hash.nearSlots(s.x[i], [&](int slot) {
+                const TriangleHash::Item& item = h->items[std::size_t(slot)];
+                const double fromRest = (s.rest[i] - item.restCentre).squaredNorm();
+                if (fromRest <= allBonded2_) return;      // every corner within the horizon
+                const double near = reach + item.radius;  // a bound on its distance
+                if ((s.x[i] - item.centre).squaredNorm() >= near * near) return;
+                const auto& tri = triangles_[std::size_t(item.triangle)];
+                if (fromRest <= noneBonded2_ && bondedAtRest(i, tri, s.rest)) return;
+                const TrianglePoint c =
+                    closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+                if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
+                    reach * reach)
+                    out.emplace_back(i, item.triangle);
+            });
     };
     const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
         triangleCandidates(i, out);

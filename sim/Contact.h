@@ -40,6 +40,7 @@
 #include "sim/Collider.h"
 #include "sim/ColliderDistance.h"
 #include "sim/ContactCulling.h"
+#include "sim/PointHash.h"
 
 namespace rend::sim {
 
@@ -120,6 +121,24 @@ private:
     void fitBuiltPositions();
     void sizeNextSkin();
     void buildList(const SheetState& s);
+    /// A list build's hash of some of the kept triangles' centroids (`which`, indices into
+    /// centres, radii and kept), queried within reach of a triangle's nearest point, with what a
+    /// query reads of each triangle stored in the hash's own order.
+    struct TriangleHash {
+        struct Item {
+            Eigen::Vector3d restCentre, centre;
+            double radius;
+            int triangle;
+        };
+        TriangleHash(const Contact& contact, std::span<const int> which,
+                     std::span<const Eigen::Vector3d> centres, std::span<const double> radii,
+                     std::span<const int> kept, double reach);
+        static std::vector<Eigen::Vector3d> gather(std::span<const int> which,
+                                                   std::span<const Eigen::Vector3d> all);
+        static double widestOf(std::span<const int> which, std::span<const double> radii);
+        PointHash hash;
+        std::vector<Item> items;
+    };
     /// Candidates of particle i within `reach`, appended to out (ascending bucket, triangle).
     void collectCandidates(int i, const SheetState& s, double reach, std::vector<int>& out) const;
     bool bondedAtRest(int i, const std::array<int, 3>& tri,
@@ -148,6 +167,7 @@ private:
     /// beyond which no corner, is bonded to a particle: one test decides most triangles.
     std::vector<Eigen::Vector3d> restCentres_;
     double allBonded2_ = 0.0, noneBonded2_ = 0.0;
+    double restWidest_ = 0.0;  ///< the largest distance from a rest centroid to its corners
     double skin_ = 0.0, skinCap_ = 0.0;
     /// Finds the parts of the sheet a build has to search (ContactCulling.h).
     std::optional<ContactCulling> culling_;

@@ -7,8 +7,8 @@
 //  3. the share at a quarter of a million particles where everything touches: two pieces of a
 //     sheet lying on each other on the ground, the upper one sliding, so every particle is in
 //     contact and the candidate lists are rebuilt as it slides.
-// Usage: bench_contact [steps] (default 200 for the large sheet: long enough for its skin to
-// adapt; the scenes run a quarter of that)
+// Usage: bench_contact [steps] [off|scenes|pile] (default 200 for the large sheet: long enough
+// for its skin to adapt; the scenes run a quarter of that); a part's name runs that part alone
 
 #include <omp.h>
 
@@ -112,8 +112,14 @@ void shareAtScale(int steps) {
 
 int main(int argc, char** argv) {
     const int steps = argc > 1 ? std::atoi(argv[1]) : 200;
-    costWhenOff();
-    scenesAtFinalQuality(std::max(1, steps / 4));
-    shareAtScale(steps);
+    const std::string only = argc > 2 ? argv[2] : "";
+    if (only != "" && only != "off" && only != "scenes" && only != "pile") {
+        std::fprintf(stderr, "bench_contact: expected off, scenes or pile, found \"%s\"\n",
+                     only.c_str());
+        return 2;
+    }
+    if (only == "" || only == "off") costWhenOff();
+    if (only == "" || only == "scenes") scenesAtFinalQuality(std::max(1, steps / 4));
+    if (only == "" || only == "pile") shareAtScale(steps);
     return 0;
 }

@@ -39,6 +39,22 @@ constexpr double kCullingReach = 0.6;
 /// goes into the stretched triangles' hash.
 constexpr double kStretchedTriangle = 2.0;
 
+/// The sum of f(i) over [0, n) by fixed blocks, each summed in order, the blocks added in order:
+/// the same bits for any thread count.
+template <class T, class F>
+T blockSum(int n, T zero, F&& f) {
+    constexpr int kBlock = 4096;
+    const int blocks = (n + kBlock - 1) / kBlock;
+    std::vector<T> part(std::size_t(blocks), zero);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+    for (int b = 0; b < blocks; ++b)
+        for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
+            part[std::size_t(b)] += f(i);
+    T sum = zero;
+    for (const T& p : part) sum += p;
+    return sum;
+}
+
 Eigen::Vector3d centroid(const std::array<int, 3>& t, std::span<const Eigen::Vector3d> x) {
     return (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0;
 }
@@ -131,18 +147,29 @@ void Contact::resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const {
 void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
                                std::span<const double> mass, std::span<const std::uint8_t> free) {
     const int n = int(x.size());
-    impulse_.resize(std::size_t(n));
+    // Only the ground's height needs testing where there are no colliders: most particles are
+    // well above it and cost one comparison.
+    const bool colliders = !poses_.empty();
+    const double floor = params_.ground.enabled ? params_.ground.height + offset_
+                                                : -std::numeric_limits<double>::infinity();
+    // Each particle's momentum change, and its size for the work bound, summed by fixed blocks
+    // of particles (the same bits for any thread count); most blocks touch nothing.
+    constexpr int kBlock = 4096;
+    const int blocks = (n + kBlock - 1) / kBlock;
+    std::vector<Eigen::Vector4d> part(std::size_t(blocks), Eigen::Vector4d::Zero());
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        const Eigen::Vector3d before = v[i];
-        if (free[i]) resolveParticle(x[i], v[i]);
-        impulse_[i] = mass[i] * (v[i] - before);
-    }
-    const double speed = colliderSpeed();
-    if (speed == 0.0) return;
-    double total = 0.0;  // in particle order
-    for (const Eigen::Vector3d& p : impulse_) total += p.norm();
-    work_ += speed * total;
+    for (int b = 0; b < blocks; ++b)
+        for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+            if (!free[i] || (!colliders && x[i].z() >= floor)) continue;
+            const Eigen::Vector3d before = v[i];
+            resolveParticle(x[i], v[i]);
+            const Eigen::Vector3d p = mass[i] * (v[i] - before);
+            part[std::size_t(b)] += Eigen::Vector4d(p.x(), p.y(), p.z(), p.norm());
+        }
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    for (const Eigen::Vector4d& p : part) sum += p;
+    impulse_ = sum.head<3>();
+    work_ += colliderSpeed() * sum[3];
 }
 
 double Contact::colliderSpeed() const {
@@ -152,12 +179,6 @@ double Contact::colliderSpeed() const {
             std::max(fastest, poses_[c].velocity.norm() + poses_[c].angularVelocity.norm() *
                                                               boundingRadius(params_.colliders[c]));
     return fastest;
-}
-
-Eigen::Vector3d Contact::lastImpulse() const {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : impulse_) sum += p;
-    return sum;
 }
 
 double Contact::stepLimit(double maxSpeed) const {
@@ -175,41 +196,33 @@ double Contact::stepLimit(double maxSpeed) const {
 
 // ---- self-contact ----------------------------------------------------------------------------
 
-namespace {
-
-/// The sum of f(i) over [0, n) by fixed blocks, each summed in order, the blocks added in order:
-/// the same bits for any thread count.
-template <class T, class F>
-T blockSum(int n, T zero, F&& f) {
-    constexpr int kBlock = 4096;
-    const int blocks = (n + kBlock - 1) / kBlock;
-    std::vector<T> part(std::size_t(blocks), zero);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int b = 0; b < blocks; ++b)
-        for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
-            part[std::size_t(b)] += f(i);
-    T sum = zero;
-    for (const T& p : part) sum += p;
-    return sum;
-}
-
-}  // namespace
-
 // A common translation changes no distance, so the list goes stale only once two particles may
-// have closed by the skin: some particle has moved more than skin / 2 relative to the mean
-// displacement (a falling sheet keeps its list). Past that, a stretching sheet may still keep
-// it: see staleAfterAffineFit.
-bool Contact::listStale(std::span<const Eigen::Vector3d> x) const {
+// have closed by the skin: some particle has moved more than skin / 2 relative to a common
+// displacement c (a falling sheet keeps its list). Any c bounds it, |u_i - u_j| <= |u_i - c| +
+// |u_j - c|, so one pass measures against the mean displacement extrapolated from the last two
+// evaluations (exact for a steady drift) while it sums the next mean. Past that, a stretching
+// sheet may still keep it: see staleAfterAffineFit.
+bool Contact::listStale(std::span<const Eigen::Vector3d> x) {
     if (builtAt_.size() != x.size()) return true;
     const int n = int(x.size());
-    const Eigen::Vector3d mean =
-        blockSum(n, Eigen::Vector3d::Zero().eval(), [&](int i) { return x[i] - builtAt_[i]; }) /
-        double(n);
-    const double limit = 0.25 * skin_ * skin_;  // (skin / 2)^2
-    double moved = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : moved) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) moved = std::max(moved, (x[i] - builtAt_[i] - mean).squaredNorm());
-    return moved > limit && staleAfterAffineFit(x, mean);
+    const Eigen::Vector3d centre = 2.0 * lastMean_[0] - lastMean_[1];
+    struct Drift {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        double most = 0.0;  // squared
+        Drift& operator+=(const Drift& o) {
+            sum += o.sum;
+            most = std::max(most, o.most);
+            return *this;
+        }
+    };
+    const Drift drift = blockSum(n, Drift{}, [&](int i) {
+        const Eigen::Vector3d u = x[i] - builtAt_[i];
+        return Drift{u, (u - centre).squaredNorm()};
+    });
+    const Eigen::Vector3d mean = drift.sum / double(n);
+    lastMean_ = {mean, lastMean_[0]};
+    drift_ = std::sqrt(drift.most);
+    return drift.most > 0.25 * skin_ * skin_ && staleAfterAffineFit(x, mean);
 }
 
 // The displacement since the build fitted by least squares as u = mean + G (X - centre), with
@@ -359,7 +372,7 @@ void Contact::buildList(const SheetState& s) {
         const int j = searched[std::size_t(points.item(int(slot)))];
         particleItems[slot] = {s.rest[j], j};
     }
-    const auto triangleCandidates = [&](int i, std::vector<std::pair<int, int>>& out) {
+    const auto triangleCandidates = [&](int i, std::vector<Candidate>& out) {
         for (const TriangleHash* h : {&usualHash, &stretchedHash})
             h->hash.nearSlots(s.x[i], [&](int slot) {
                 const TriangleHash::Item& item = h->items[std::size_t(slot)];
@@ -371,45 +384,79 @@ void Contact::buildList(const SheetState& s) {
                 if (fromRest <= noneBonded2_ && bondedAtRest(i, tri, s.rest)) return;
                 const TrianglePoint c =
                     closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
-                if ((s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm() <
-                    reach * reach)
-                    out.emplace_back(i, item.triangle);
+                const double d2 =
+                    (s.x[i] - c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]])).squaredNorm();
+                if (d2 < reach * reach) out.push_back({i, item.triangle, std::sqrt(d2)});
             });
     };
-    const auto candidates = [&](int i, std::vector<std::pair<int, int>>& out) {
+    const auto candidates = [&](int i, std::vector<Candidate>& out) {
         triangleCandidates(i, out);
         points.nearSlots(s.x[i], [&](int slot) {
             const ParticleItem& item = particleItems[std::size_t(slot)];
             if (item.particle == i || (s.rest[i] - item.rest).squaredNorm() <= restExclusion2_)
                 return;
-            out.emplace_back(i, -(item.particle + 1));  // a particle: negative
+            out.push_back({i, -(item.particle + 1), 0.0});  // a particle: negative
         });
     };
-    std::vector<std::vector<std::pair<int, int>>> found;
+    std::vector<std::vector<Candidate>> found;
 #pragma omp parallel if (n >= kParallelThreshold)
     {
 #pragma omp single
         found.resize(std::size_t(omp_get_num_threads()));
-        std::vector<std::pair<int, int>>& mine = found[std::size_t(omp_get_thread_num())];
+        std::vector<Candidate>& mine = found[std::size_t(omp_get_thread_num())];
 #pragma omp for schedule(static)
         for (int i = 0; i < n; ++i)
             if (active[std::size_t(i)] == 1) candidates(i, mine);
     }
-    listStart_.assign(std::size_t(n) + 1, 0);
-    list_.clear();
-    for (const auto& part : found)  // thread order is particle order
-        for (const auto& [i, t] : part) {
-            ++listStart_[std::size_t(i) + 1];
-            list_.push_back(t);
-        }
-    for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
-    listed_.clear();
-    for (int i = 0; i < n; ++i)
-        if (listStart_[std::size_t(i) + 1] > listStart_[std::size_t(i)]) listed_.push_back(i);
+    storeList(n, found);
     builtAt_.assign(s.x.begin(), s.x.end());
+    drift_ = 0.0;
+    lastMean_ = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     fitBuiltPositions();
     ++builds_;
     sizeNextSkin();
+}
+
+// The candidates as CSR lists, each particle's particles first, then its triangles nearest
+// first at the build (ties by index), with those distances rounded down: nearestContact stops at
+// the first triangle that cannot be nearer than the nearest found so far.
+void Contact::storeList(int n, std::span<const std::vector<Candidate>> found) {
+    listStart_.assign(std::size_t(n) + 1, 0);
+    std::size_t total = 0;
+    for (const auto& part : found) {
+        total += part.size();
+        for (const Candidate& c : part) ++listStart_[std::size_t(c.particle) + 1];
+    }
+    for (int i = 0; i < n; ++i) listStart_[std::size_t(i) + 1] += listStart_[std::size_t(i)];
+    list_.resize(total);
+    listDistance_.resize(total);
+    std::vector<Candidate> all;  // thread order is particle order
+    all.reserve(total);
+    for (const auto& part : found) all.insert(all.end(), part.begin(), part.end());
+    listed_.clear();
+    for (int i = 0; i < n; ++i)
+        if (listStart_[std::size_t(i) + 1] > listStart_[std::size_t(i)]) listed_.push_back(i);
+    const int listed = int(listed_.size());
+#pragma omp parallel for schedule(static) if (listed >= kParallelThreshold)
+    for (int k = 0; k < listed; ++k) {
+        const int i = listed_[std::size_t(k)];
+        const auto first = all.begin() + listStart_[std::size_t(i)];
+        const auto last = all.begin() + listStart_[std::size_t(i) + 1];
+        std::sort(first, last, [](const Candidate& a, const Candidate& b) {
+            const bool pointA = a.target < 0, pointB = b.target < 0;
+            if (pointA != pointB) return pointA;
+            if (a.distance != b.distance) return a.distance < b.distance;
+            return a.target < b.target;
+        });
+        for (auto c = first; c != last; ++c) {
+            const std::size_t at = std::size_t(c - all.begin());
+            list_[at] = c->target;
+            // Rounded down: a float never above the double it stands for.
+            float lower = float(c->distance);
+            if (double(lower) > c->distance) lower = std::nextafter(lower, 0.0f);
+            listDistance_[at] = lower;
+        }
+    }
 }
 
 // The force on particle i from the point of triangle `tri` with barycentric weights w: a damped
@@ -452,6 +499,11 @@ Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const 
     Eigen::Vector3d closest;
     for (int k = listStart_[std::size_t(i)]; k < listStart_[std::size_t(i) + 1]; ++k) {
         const int t = list_[std::size_t(k)];
+        // Nothing since the build moved more than drift_ relative to the mean motion, so no
+        // point of a triangle closed on i by more than twice that; the rest of the list was
+        // farther at the build.
+        const double nearest = double(listDistance_[std::size_t(k)]) - 2.0 * drift_;
+        if (t >= 0 && nearest > 0.0 && nearest * nearest >= best) break;
         if (t < 0) {
             const int j = -t - 1;
             if ((s.x[i] - s.x[j]).squaredNorm() >= thickness_ * thickness_) continue;

@@ -77,6 +77,8 @@ public:
     /// Adds the self-contact forces to `force`.
     void addSelfContactForces(const SheetState& sheet, std::vector<Eigen::Vector3d>& force);
 
+    /// Whether stepLimit can be finite: self-contact or a collider (the ground sets no limit).
+    bool limitsStep() const { return params_.self.enabled || !params_.colliders.empty(); }
     /// The longest step the contact allows with particles moving at most `maxSpeed`.
     double stepLimit(double maxSpeed) const;
 
@@ -88,7 +90,7 @@ public:
         return w;
     }
     /// The momentum the ground and colliders gave the sheet in the last resolve [N s].
-    Eigen::Vector3d lastImpulse() const;
+    Eigen::Vector3d lastImpulse() const { return impulse_; }
     /// Contacts within d at the last force evaluation: particle-triangle ones, and
     /// particle-particle ones counted from both ends.
     std::size_t lastPairCount() const { return pairs_; }
@@ -115,12 +117,21 @@ private:
     };
     void setUpTriangles(std::span<const std::array<int, 3>> triangles,
                         std::span<const Eigen::Vector3d> rest, double reach);
-    bool listStale(std::span<const Eigen::Vector3d> x) const;
+    /// Whether the list may have left out something now within d; records drift_.
+    bool listStale(std::span<const Eigen::Vector3d> x);
     /// The list's guarantee under the affine motion fitted since the build (see listStale).
     bool staleAfterAffineFit(std::span<const Eigen::Vector3d> x, const Eigen::Vector3d& mean) const;
     void fitBuiltPositions();
     void sizeNextSkin();
     void buildList(const SheetState& s);
+    /// A candidate of a build: a kept triangle (>= 0) or a particle (-1 - index), and its
+    /// distance from the particle at the build (particles: 0).
+    struct Candidate {
+        int particle, target;
+        double distance;
+    };
+    /// The candidates found by each thread, in particle order, as the CSR list.
+    void storeList(int n, std::span<const std::vector<Candidate>> found);
     /// A list build's hash of some of the kept triangles' centroids (`which`, indices into
     /// centres, radii and kept), queried within reach of a triangle's nearest point, with what a
     /// query reads of each triangle stored in the hash's own order.
@@ -155,8 +166,8 @@ private:
     double stiffnessRate_ = 0.0, dampingRate_ = 0.0;   ///< this evaluation's, from the speeds
     std::vector<std::optional<MeshDistance>> meshes_;  ///< per collider, for meshes
     std::vector<ColliderPose> poses_;
-    std::vector<Eigen::Vector3d> impulse_;  ///< per particle, the last resolve's momentum change
-    double work_ = 0.0;                     ///< takeWork's sum
+    Eigen::Vector3d impulse_ = Eigen::Vector3d::Zero();  ///< the last resolve's momentum change
+    double work_ = 0.0;                                  ///< takeWork's sum
     /// The fastest collider point at the current poses [m/s].
     double colliderSpeed() const;
 
@@ -180,6 +191,12 @@ private:
     Eigen::Matrix3d builtScatterInverse_ = Eigen::Matrix3d::Zero();
     Eigen::MatrixXd builtSpan_;
     std::vector<int> listStart_, list_;
+    /// Per list entry: its distance at the build, rounded down (triangles; particles 0).
+    std::vector<float> listDistance_;
+    /// The most a particle has moved since the build relative to a common displacement [m].
+    double drift_ = 0.0;
+    /// The mean displacement since the build at the last two evaluations (listStale).
+    std::array<Eigen::Vector3d, 2> lastMean_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::vector<int> listed_;             ///< the particles whose lists are not empty, ascending
     std::vector<PointContact> contacts_;  ///< per listed particle, this evaluation's
     std::size_t pairs_ = 0;

@@ -193,8 +193,10 @@ void Membrane::collide(double tNext) {
     contactSeconds_ += omp_get_wtime() - t0;
 }
 
+// The ground alone sets no limit: nothing is spent finding the fastest particle for it.
 double Membrane::contactStepLimit() const {
-    return contact_ ? contact_->stepLimit(maxSpeed()) : std::numeric_limits<double>::infinity();
+    return contact_ && contact_->limitsStep() ? contact_->stepLimit(maxSpeed())
+                                              : std::numeric_limits<double>::infinity();
 }
 
 void Membrane::accumulateForces() {

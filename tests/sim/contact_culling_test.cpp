@@ -274,3 +274,48 @@ TEST(ContactCulling, StretchedTrianglesLaidOverTheSheetAreFound) {
     EXPECT_GT(expected, 0u);
     EXPECT_EQ(contact.lastPairCount(), expected);
 }
+
+// Each step walks a particle's candidates nearest first at the build and stops at the first that
+// cannot be nearer than the nearest so far, given how far anything drifted since: a list kept
+// across evaluations gives the forces of a list built afresh at each one, while a folded layer
+// slides and ripples over the other.
+TEST(ContactCulling, AKeptListStopsAtTheSameNearestTriangleAsAFreshOne) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
+    ContactParams params;
+    params.self.enabled = true;
+    const double d = 0.5 * kDx;
+    Contact kept(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+    const int n = int(s.rest().size());
+    const std::vector<double> mass(std::size_t(n), 1.0);
+    const std::vector<Eigen::Vector3d> v(std::size_t(n), Eigen::Vector3d::Zero());
+    std::size_t touching = 0;
+    for (int frame = 0; frame <= 40; ++frame) {
+        // Folded over at x = 0, the upper layer 0.8 d above the lower, sliding along y and
+        // rippling as it goes.
+        const double slide = 0.03 * kDx * frame, phase = 0.3 * frame;
+        const std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                if (p.x() <= 0.0) return p;
+                const double r = 0.4 * d, a = std::min(p.x() / r, M_PI);
+                const double beyond = std::max(0.0, p.x() - M_PI * r);
+                const double ripple = 0.1 * d * std::sin(400.0 * p.x() + 300.0 * p.y() + phase);
+                const double along = beyond > 0.0 ? slide : 0.0;
+                return {r * std::sin(a) - beyond, p.y() + along,
+                        r * (1 - std::cos(a)) + (beyond > 0.0 ? ripple : 0.0)};
+            });
+        std::vector<Eigen::Vector3d> fromKept(std::size_t(n), Eigen::Vector3d::Zero());
+        kept.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromKept);
+        Contact fresh(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+        std::vector<Eigen::Vector3d> fromFresh(std::size_t(n), Eigen::Vector3d::Zero());
+        fresh.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromFresh);
+        ASSERT_EQ(kept.lastPairCount(), fresh.lastPairCount()) << "frame " << frame;
+        double largest = 0.0;
+        for (const Eigen::Vector3d& f : fromFresh) largest = std::max(largest, f.norm());
+        for (int i = 0; i < n; ++i)
+            ASSERT_LE((fromKept[std::size_t(i)] - fromFresh[std::size_t(i)]).norm(), 1e-9 * largest)
+                << "particle " << i << ", frame " << frame;
+        touching = std::max(touching, kept.lastPairCount());
+    }
+    EXPECT_GT(touching, 400u);         // the layers touch
+    EXPECT_LT(kept.listBuilds(), 20);  // and the list was kept across frames
+}

@@ -27,6 +27,22 @@ constexpr double kBigTile = 2.0;
 /// (the square lattice's worst case, across its diagonals).
 constexpr double kEdgePath = 1.4142135623730951;
 
+/// The pseudo-inverse of a scatter matrix over the directions it spans, leaving out those whose
+/// spread is below kThinSpan of the widest (a flat sheet's seeded jitter), and those directions.
+Eigen::Matrix3d spannedInverse(const Eigen::Matrix3d& scatter, std::vector<Eigen::Vector3d>* span) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    const double largest = eigen.eigenvalues().maxCoeff();
+    Eigen::Matrix3d inverse = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+        const double lambda = eigen.eigenvalues()[k];
+        if (!(largest > 0.0) || lambda <= kThinSpan * kThinSpan * largest) continue;
+        const Eigen::Vector3d q = eigen.eigenvectors().col(k);
+        inverse += q * q.transpose() / lambda;
+        if (span) span->push_back(q);
+    }
+    return inverse;
+}
+
 Cell cellOf(const Eigen::Vector3d& x, double size) {
     const Eigen::Vector3i c = (x / size).array().floor().cast<int>();
     return {c.x(), c.y(), c.z()};
@@ -109,18 +125,10 @@ void ContactCulling::setUpTiles(std::span<const Eigen::Vector3d> rest, double ti
                 const Eigen::Vector3d c = rest[std::size_t(i)] - tile.restCentre;
                 scatter += c * c.transpose();
             }
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
-        const double largest = eigen.eigenvalues().maxCoeff();
+        // A direction the neighbourhood hardly spans is left out of the fit; its extent shortens
+        // the rest clearance instead (smooth).
         std::vector<Eigen::Vector3d> span;
-        for (int k = 0; k < 3; ++k) {
-            const double lambda = eigen.eigenvalues()[k];
-            // A direction the neighbourhood hardly spans (a flat sheet's seeded jitter) is left
-            // out of the fit; its extent shortens the rest clearance instead (clearance).
-            if (!(largest > 0.0) || lambda <= kThinSpan * kThinSpan * largest) continue;
-            const Eigen::Vector3d q = eigen.eigenvectors().col(k);
-            tile.restInverse += q * q.transpose() / lambda;
-            span.push_back(q);
-        }
+        tile.restInverse = spannedInverse(scatter, &span);
         tile.span.resize(3, Eigen::Index(span.size()));
         for (std::size_t k = 0; k < span.size(); ++k) tile.span.col(Eigen::Index(k)) = span[k];
         const Eigen::Matrix3d across =
@@ -129,7 +137,20 @@ void ContactCulling::setUpTiles(std::span<const Eigen::Vector3d> rest, double ti
             for (const int i : tiles_[std::size_t(b)].particles)
                 tile.outOfSpan = std::max(
                     tile.outOfSpan, (across * (rest[std::size_t(i)] - tile.restCentre)).norm());
+        setUpOwnFit(tile, rest);
     }
+}
+
+void ContactCulling::setUpOwnFit(Tile& tile, std::span<const Eigen::Vector3d> rest) {
+    for (const int i : tile.particles) tile.ownCentre += rest[std::size_t(i)];
+    tile.ownCentre /= double(tile.particles.size());
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const int i : tile.particles) {
+        const Eigen::Vector3d c = rest[std::size_t(i)] - tile.ownCentre;
+        scatter += c * c.transpose();
+        tile.ownRadius = std::max(tile.ownRadius, c.norm());
+    }
+    tile.ownInverse = spannedInverse(scatter, nullptr);
 }
 
 // The least rest distance between particles not bonded at rest, searched within twice the bond
@@ -220,10 +241,14 @@ int ContactCulling::mark(std::span<const Eigen::Vector3d> x, double reach,
             m.cross += p * rest_[std::size_t(i)].transpose();
         }
     }
+    std::vector<OwnFit> own(tiles_.size());
+#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
+    for (int t = 0; t < tiles; ++t)
+        own[std::size_t(t)] = ownFit(tiles_[std::size_t(t)], moments[std::size_t(t)], x);
     std::vector<std::uint8_t> tileActive(std::size_t(tiles), 0);
 #pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
     for (int t = 0; t < tiles; ++t)
-        tileActive[std::size_t(t)] = !smooth(tiles_[std::size_t(t)], moments, x, reach);
+        tileActive[std::size_t(t)] = !smooth(tiles_[std::size_t(t)], moments, own, x, reach);
     markOverlaps(x, reach, edge, tileActive);
     // What the search lists for: the active tiles' particles (1); the triangles it lists from
     // have a corner in an active tile or one beside it (2).
@@ -242,10 +267,45 @@ int ContactCulling::mark(std::span<const Eigen::Vector3d> x, double reach,
     return count;
 }
 
+// The tile's own fit, by the moments mark has just summed, and its largest residual (x relative
+// to x[0], as the moments).
+ContactCulling::OwnFit ContactCulling::ownFit(const Tile& tile, const Moments& m,
+                                              std::span<const Eigen::Vector3d> x) const {
+    OwnFit fit;
+    fit.centre = m.sum / double(tile.particles.size());
+    fit.f = (m.cross - double(tile.particles.size()) * fit.centre * tile.ownCentre.transpose()) *
+            tile.ownInverse;
+    double most = 0.0;  // squared
+    for (const int i : tile.particles)
+        most = std::max(most, (x[std::size_t(i)] - x[0] - fit.centre -
+                               fit.f * (rest_[std::size_t(i)] - tile.ownCentre))
+                                  .squaredNorm());
+    fit.residual = std::sqrt(most);
+    return fit;
+}
+
+// A bound on the neighbourhood's residuals from its tiles' own fits, without visiting a
+// particle: for particle i of tile b, exactly,
+//   r_i = r_i^b + [c_b - centre - F (ownCentre_b - restCentre)] + (F_b - F) (X_i - ownCentre_b),
+// so |r_i| <= max|r^b| + |that shift| + |F_b - F|_Frobenius ownRadius_b.
+double ContactCulling::residualBound(const Tile& tile, std::span<const OwnFit> own,
+                                     const Eigen::Vector3d& centre,
+                                     const Eigen::Matrix3d& f) const {
+    double bound = 0.0;
+    for (const int b : tile.beside) {
+        const OwnFit& o = own[std::size_t(b)];
+        const Tile& part = tiles_[std::size_t(b)];
+        const Eigen::Vector3d shift = o.centre - centre - f * (part.ownCentre - tile.restCentre);
+        bound = std::max(bound, o.residual + shift.norm() + (o.f - f).norm() * part.ownRadius);
+    }
+    return bound;
+}
+
 // The neighbourhood's affine fit x = centre + F (X - restCentre) + r: quiet when
 // sigma restClearance - 2 max|r| >= reach.
 bool ContactCulling::smooth(const Tile& tile, std::span<const Moments> moments,
-                            std::span<const Eigen::Vector3d> x, double reach) const {
+                            std::span<const OwnFit> own, std::span<const Eigen::Vector3d> x,
+                            double reach) const {
     if (tile.span.cols() == 0) return true;  // a single particle
     Moments sum;
     for (const int b : tile.beside) {
@@ -268,6 +328,7 @@ bool ContactCulling::smooth(const Tile& tile, std::span<const Moments> moments,
         std::sqrt(std::max(0.0, restClearance_ * restClearance_ - outOfSpan * outOfSpan));
     const double allowed = 0.5 * (sigma * clearance - reach);  // on max|r|
     if (allowed <= 0.0) return false;                          // no residual bound can pass either
+    if (residualBound(tile, own, centre, f) <= allowed) return true;  // no particle visited
     // A sheet's neighbourhood maps onto a plane: residuals across it (waves, jitter, a gentle
     // bend) only move points apart, |x_i - x_j|^2 = |F dX + dr_along|^2 + dr_across^2, so only
     // the part along the plane counts.

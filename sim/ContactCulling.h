@@ -58,13 +58,29 @@ private:
         Eigen::MatrixXd span;
         double outOfSpan = 0.0;  ///< the farthest rest particle off the span, from the centre
         int count = 0;           ///< particles in the neighbourhood
+        /// The tile's own particles at rest: their centre, the pseudo-inverse of their scatter,
+        /// and the farthest from the centre.
+        Eigen::Vector3d ownCentre = Eigen::Vector3d::Zero();
+        Eigen::Matrix3d ownInverse = Eigen::Matrix3d::Zero();
+        double ownRadius = 0.0;
     };
     /// Current moments of one tile: the sum of x, and of x X^T (X at rest).
     struct Moments {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
     };
+    /// A tile's own affine fit at a build: x - x[0] = centre + f (X - ownCentre) + r, |r| <=
+    /// residual.
+    struct OwnFit {
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+        double residual = 0.0;
+    };
+    OwnFit ownFit(const Tile& tile, const Moments& m, std::span<const Eigen::Vector3d> x) const;
+    double residualBound(const Tile& tile, std::span<const OwnFit> own,
+                         const Eigen::Vector3d& centre, const Eigen::Matrix3d& f) const;
     void setUpTiles(std::span<const Eigen::Vector3d> rest, double tileSize);
+    void setUpOwnFit(Tile& tile, std::span<const Eigen::Vector3d> rest);
     void measureRestClearance(std::span<const Eigen::Vector3d> rest, double bondReach2);
     void measureTriangleClearance(std::span<const Eigen::Vector3d> rest,
                                   std::span<const std::array<int, 3>> triangles, double bondReach2);
@@ -72,7 +88,7 @@ private:
                                      std::span<const std::array<int, 3>> triangles,
                                      std::span<const std::uint8_t> kept) const;
     void setUpEdges(std::span<const std::array<int, 3>> triangles);
-    bool smooth(const Tile& tile, std::span<const Moments> moments,
+    bool smooth(const Tile& tile, std::span<const Moments> moments, std::span<const OwnFit> own,
                 std::span<const Eigen::Vector3d> x, double reach) const;
     /// The most the residual's part along the plane changes per unit rest length along an edge.
     double residualSlope(const Tile& tile, std::span<const Eigen::Vector3d> x,

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -210,6 +211,65 @@ TEST(ContactCulling, UnevenSqueezesLeaveNothingOut) {
     }
     EXPECT_GT(searched, 0);
     EXPECT_GT(quiet, 0);
+}
+
+// Shapes the tiles' own fits see differently from their neighbourhood's (the bound that spares
+// a quiet neighbourhood its particle pass): strips slid past each other along the sheet by
+// random offsets, as torn strips slide, and in-plane ripples shorter than a tile, at random.
+TEST(ContactCulling, SlidingStripsAndShortRipplesLeaveNothingOut) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.16, 0.12});
+    const ContactCulling culling(s.rest(), s.lattice.triangles, kBondReach * kBondReach,
+                                 3 * kBondReach);
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    int searched = 0, quiet = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+        const double reach = (0.6 + 0.4 * uniform(random)) * kDx;
+        std::vector<double> cuts, offsets;  // strips along x, each slid by its own offset
+        for (double y = -0.06; y < 0.06; y += (2 + 8 * uniform(random)) * kDx) {
+            cuts.push_back(y);
+            offsets.push_back((trial % 2 ? 1.5 : 0.2) * kDx * (2 * uniform(random) - 1));
+        }
+        const double k = 2 * M_PI / ((1.5 + 2.5 * uniform(random)) * kDx);
+        const double depth = trial % 3 == 0 ? 0.3 + 0.6 * uniform(random) : 0.0;
+        const std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                const auto strip = std::upper_bound(cuts.begin(), cuts.end(), p.y());
+                const double slide =
+                    strip == cuts.begin() ? 0.0 : offsets[strip - cuts.begin() - 1];
+                return {p.x() + slide - depth * std::sin(k * p.x()) / k, p.y(), p.z()};
+            });
+        std::vector<std::uint8_t> active;
+        const int marked = culling.mark(x, reach, s.lattice.triangles, {}, active);
+        searched += marked > 0;
+        quiet += marked < int(x.size());
+        expectContract(s, x, reach, active);
+    }
+    EXPECT_GT(searched, 0);
+    EXPECT_GT(quiet, 0);
+}
+
+// Rows of tiles slid across by turns, +a and -a, into and away from each other: each tile moved
+// rigidly (its own fit exact), its neighbourhood's fit a plain translation (the rows' slides
+// cancel by symmetry), so only the shift between each tile's fit and its neighbourhood's tells
+// the rows' edges apart.
+TEST(ContactCulling, RowsOfTilesSlidByTurnsLeaveNothingOut) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.4, 0.3});
+    const double tileSize = 3 * kBondReach;
+    const ContactCulling culling(s.rest(), s.lattice.triangles, kBondReach * kBondReach, tileSize);
+    const Eigen::Vector3d origin = s.rest()[0];  // the culling's tiles start from particle 0
+    for (const double a : {0.3 * kDx, 0.4 * kDx, 0.5 * kDx, 0.6 * kDx}) {
+        const std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                const int row = int(std::floor((p.y() - origin.y()) / tileSize));
+                return p + Eigen::Vector3d(0.0, row % 2 == 0 ? a : -a, 0.0);
+            });
+        std::vector<std::uint8_t> active;
+        culling.mark(x, 0.9 * kDx, s.lattice.triangles, {}, active);
+        expectContract(s, x, 0.9 * kDx, active);
+        // From a = 0.5 dx on, the rows pushed into each other overlap.
+        if (a >= 0.5 * kDx) EXPECT_GT(contactsByBruteForce(s, x, 0.9 * kDx), 0u);
+    }
 }
 
 // The candidate list, kept across evaluations while the sheet stretches, bends and folds, finds

@@ -79,6 +79,24 @@ std::size_t contactsByBruteForce(const Sheet& s, std::span<const Eigen::Vector3d
     return count;
 }
 
+/// Shapes marked at random: each keeps mark's contract, and over all of them some were searched
+/// and some left quiet (so the shapes test both sides of the bounds).
+struct MarkTally {
+    int searched = 0, quiet = 0;
+    void check(const Sheet& s, const ContactCulling& culling, std::span<const Eigen::Vector3d> x,
+               double reach) {
+        std::vector<std::uint8_t> active;
+        const int marked = culling.mark(x, reach, s.lattice.triangles, {}, active);
+        searched += marked > 0;
+        quiet += marked < int(x.size());
+        expectContract(s, x, reach, active);
+    }
+    void expectBoth() const {
+        EXPECT_GT(searched, 0);
+        EXPECT_GT(quiet, 0);
+    }
+};
+
 using Deform = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 
 std::vector<Eigen::Vector3d> deformed(const Sheet& s, const Deform& f) {
@@ -192,7 +210,7 @@ TEST(ContactCulling, UnevenSqueezesLeaveNothingOut) {
                                  3 * kBondReach);
     std::mt19937 random(11);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    int searched = 0, quiet = 0;
+    MarkTally tally;
     for (int trial = 0; trial < 40; ++trial) {
         const double k = 2 * M_PI / ((4 + 16 * uniform(random)) * kDx);
         const double depth = 0.3 + 0.6 * uniform(random), phase = 6.3 * uniform(random);
@@ -203,14 +221,9 @@ TEST(ContactCulling, UnevenSqueezesLeaveNothingOut) {
             deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
                 return {p.x() - depth * std::sin(k * p.x() + phase) / k, p.y(), p.z()};
             });
-        std::vector<std::uint8_t> active;
-        const int marked = culling.mark(x, reach, s.lattice.triangles, {}, active);
-        searched += marked > 0;
-        quiet += marked < int(x.size());
-        expectContract(s, x, reach, active);
+        tally.check(s, culling, x, reach);
     }
-    EXPECT_GT(searched, 0);
-    EXPECT_GT(quiet, 0);
+    tally.expectBoth();
 }
 
 // Shapes the tiles' own fits see differently from their neighbourhood's (the bound that spares
@@ -222,7 +235,7 @@ TEST(ContactCulling, SlidingStripsAndShortRipplesLeaveNothingOut) {
                                  3 * kBondReach);
     std::mt19937 random(5);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    int searched = 0, quiet = 0;
+    MarkTally tally;
     for (int trial = 0; trial < 30; ++trial) {
         const double reach = (0.6 + 0.4 * uniform(random)) * kDx;
         std::vector<double> cuts, offsets;  // strips along x, each slid by its own offset
@@ -239,14 +252,9 @@ TEST(ContactCulling, SlidingStripsAndShortRipplesLeaveNothingOut) {
                     strip == cuts.begin() ? 0.0 : offsets[strip - cuts.begin() - 1];
                 return {p.x() + slide - depth * std::sin(k * p.x()) / k, p.y(), p.z()};
             });
-        std::vector<std::uint8_t> active;
-        const int marked = culling.mark(x, reach, s.lattice.triangles, {}, active);
-        searched += marked > 0;
-        quiet += marked < int(x.size());
-        expectContract(s, x, reach, active);
+        tally.check(s, culling, x, reach);
     }
-    EXPECT_GT(searched, 0);
-    EXPECT_GT(quiet, 0);
+    tally.expectBoth();
 }
 
 // Rows of tiles slid across by turns, +a and -a, into and away from each other: each tile moved

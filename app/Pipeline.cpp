@@ -181,13 +181,14 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << ", \"growth\": " << s.limitedBy[3] << "},\n"
       << "  \"largest_burst\": " << s.largestBurst << ",\n"
       << "  \"extra_substeps\": " << s.extraSubsteps << ",\n"
+      << "  \"contact_list_builds\": " << s.contactListBuilds << ",\n"
       << "  \"frames_simulated\": " << s.framesSimulated << ",\n"
       << "  \"frames_written\": " << s.framesWritten << ",\n"
       << "  \"threads\": " << omp_get_max_threads() << ",\n"
       << "  \"wall_seconds\": {\"setup\": " << s.seconds.setup
       << ", \"simulate\": " << s.seconds.simulate << ", \"contact\": " << s.seconds.contact
-      << ", \"surface\": " << s.seconds.surface << ", \"render\": " << s.seconds.render
-      << ", \"write\": " << s.seconds.write << "},\n"
+      << ", \"contact_lists\": " << s.seconds.contactLists << ", \"surface\": " << s.seconds.surface
+      << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write << "},\n"
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
       << "  \"state_hash\": " << jsonString(hash) << ",\n"
       << "  \"files\": " << jsonStringArray(files, "  ") << ",\n"
@@ -359,6 +360,10 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.steps = membrane.stepCount();
         s.extraSubsteps = membrane.extraSubsteps();
         s.seconds.contact = membrane.contactSeconds();
+        if (const sim::Contact* contact = membrane.contact()) {
+            s.seconds.contactLists = contact->listBuildSeconds();
+            s.contactListBuilds = contact->listBuilds();
+        }
         if (adaptive && s.steps > 0) {
             s.dt = membrane.time() / double(s.steps);
             s.dtMin = membrane.smallestTimeStep();

@@ -23,7 +23,8 @@ struct RunOptions {
 struct StageTimes {
     double setup = 0.0;
     double simulate = 0.0;
-    double contact = 0.0;  ///< of simulate: ground, colliders and self-contact
+    double contact = 0.0;       ///< of simulate: ground, colliders and self-contact
+    double contactLists = 0.0;  ///< of contact: the self-contact's candidate-list builds
     double surface = 0.0;
     double render = 0.0;
     double write = 0.0;
@@ -41,7 +42,8 @@ struct RunSummary {
     std::array<long, 4> limitedBy{};
     std::size_t largestBurst = 0;  ///< adaptive: the most bonds one step broke
     long steps = 0;
-    long extraSubsteps = 0;  ///< pieces the power law's stiffening cut steps into, beyond steps
+    long extraSubsteps = 0;      ///< pieces the power law's stiffening cut steps into, beyond steps
+    long contactListBuilds = 0;  ///< the self-contact's candidate-list builds
     int framesSimulated = 0;
     int framesWritten = 0;
     StageTimes seconds;

@@ -34,8 +34,40 @@ struct TrianglePoint {
         return weights[0] * a + weights[1] * b + weights[2] * c;
     }
 };
-TrianglePoint closestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+/// The closest point of triangle abc to p by Voronoi regions of its corners, edges and face
+/// (Ericson, Real-Time Collision Detection, 5.1.5); inline, as the self-contact calls it a few
+/// times per particle and step.
+inline TrianglePoint closestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    using F = TrianglePoint::Feature;
+    const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return {{1, 0, 0}, F::Corner, 0};
+    const Eigen::Vector3d bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return {{0, 1, 0}, F::Corner, 1};
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        const double u = d1 / (d1 - d3);
+        return {{1 - u, u, 0}, F::Edge, 0};
+    }
+    const Eigen::Vector3d cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return {{0, 0, 1}, F::Corner, 2};
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        const double u = d2 / (d2 - d6);
+        return {{1 - u, 0, u}, F::Edge, 2};
+    }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        const double u = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return {{0, 1 - u, u}, F::Edge, 1};
+    }
+    const double denom = 1.0 / (va + vb + vc);
+    const double v = vb * denom, w = vc * denom;
+    return {{1 - v - w, v, w}, F::Face, 0};
+}
 
 /// A closed triangle mesh prepared for distance queries within `reach` of its surface.
 class MeshDistance {

@@ -324,6 +324,7 @@ double Contact::TriangleHash::widestOf(std::span<const int> which, std::span<con
 // left out comes within d before then. Each thread lists a contiguous range of particles, in
 // order, so the lists do not depend on the thread count.
 void Contact::buildList(const SheetState& s) {
+    const double started = omp_get_wtime();
     const int n = int(s.x.size());
     const double reach = thickness_ + skin_;
     // Only the particles ContactCulling marks 1 can have anything within reach, and only
@@ -415,6 +416,7 @@ void Contact::buildList(const SheetState& s) {
     fitBuiltPositions();
     ++builds_;
     sizeNextSkin();
+    buildSeconds_ += omp_get_wtime() - started;
 }
 
 // The candidates as CSR lists, each particle's particles first, then its triangles nearest

@@ -94,8 +94,9 @@ public:
     /// Contacts within d at the last force evaluation: particle-triangle ones, and
     /// particle-particle ones counted from both ends.
     std::size_t lastPairCount() const { return pairs_; }
-    /// Candidate-list rebuilds so far.
+    /// Candidate-list rebuilds so far, and the wall seconds they took.
     long listBuilds() const { return builds_; }
+    double listBuildSeconds() const { return buildSeconds_; }
     /// Particles the last build searched (the rest were certified apart from anything not
     /// bonded to them at rest).
     int lastSearched() const { return lastActive_; }
@@ -182,6 +183,7 @@ private:
     double skin_ = 0.0, skinCap_ = 0.0;
     /// Finds the parts of the sheet a build has to search (ContactCulling.h).
     std::optional<ContactCulling> culling_;
+    double buildSeconds_ = 0.0;
     int lastActive_ = 0;                            ///< particles searched at the last build
     long evaluations_ = 0, builtAtEvaluation_ = 0;  ///< force evaluations: all, at the last build
     std::vector<Eigen::Vector3d> builtAt_;          ///< positions at the last build

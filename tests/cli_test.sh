@@ -106,6 +106,11 @@ check "sph refusal leaves no output" test ! -e "$tmp/sphsphere"
 json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2], {}, {'d': d}))" "$@"; }
 check "no surface without outputs" python3 -c "import json,sys; w=json.load(open(sys.argv[1]))['wall_seconds']; assert w['surface'] == 0 and w['render'] == 0" "$tmp/none/run.json"
 check "surface built when rendering" python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['wall_seconds']['surface'] > 0" "$tmp/ok/run.json"
+# Contact: run.json counts the self-contact's list builds and their share of its time; a scene
+# without contact has neither.
+check "no contact, no list builds" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['contact_list_builds'] == 0 and d['wall_seconds']['contact_lists'] == 0" "$tmp/none/run.json"
+check "film_poke short run" run 0 run scenes/film_poke.toml --set time.duration=0.5 --renderer none --out "$tmp/poke"
+check "contact list builds counted" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); w=d['wall_seconds']; assert d['contact_list_builds'] > 0 and 0 < w['contact_lists'] <= w['contact'] <= w['simulate'], d" "$tmp/poke/run.json"
 check "simulation identical with and without rendering" test "$(json "$tmp/none/run.json" "d['state_hash']")" = "$(json "$tmp/ok/run.json" "d['state_hash']")"
 
 # Exports and surfaces.

@@ -93,6 +93,18 @@ void Contact::setUpTriangles(std::span<const std::array<int, 3>> triangles,
             widest = std::max(widest, (rest[c] - restCentres_[t]).norm());
     }
     restWidest_ = widest;
+    const std::size_t n = rest.size();
+    vertexTriangleStart_.assign(n + 1, 0);
+    for (const auto& tri : triangles_)
+        for (const int corner : tri) ++vertexTriangleStart_[std::size_t(corner) + 1];
+    for (std::size_t i = 0; i < n; ++i) vertexTriangleStart_[i + 1] += vertexTriangleStart_[i];
+    vertexTriangles_.resize(std::size_t(vertexTriangleStart_[n]));
+    std::vector<int> fill(vertexTriangleStart_.begin(), vertexTriangleStart_.end() - 1);
+    for (std::size_t t = 0; t < triangles_.size(); ++t)
+        for (const int corner : triangles_[t])
+            vertexTriangles_[std::size_t(fill[std::size_t(corner)]++)] = int(t);
+    isMover_.assign(n, 0);
+    touchesMover_.assign(triangles_.size(), 0);
     allBonded2_ = reach > widest ? (reach - widest) * (reach - widest) : -1.0;
     noneBonded2_ = (reach + widest) * (reach + widest);
     culling_.emplace(rest, triangles, reach * reach, kTileSize * reach);
@@ -222,7 +234,9 @@ bool Contact::listStale(std::span<const Eigen::Vector3d> x) {
     const Eigen::Vector3d mean = drift.sum / double(n);
     lastMean_ = {mean, lastMean_[0]};
     drift_ = std::sqrt(drift.most);
-    return drift.most > 0.25 * skin_ * skin_ && staleAfterAffineFit(x, mean);
+    clearMovers();
+    if (drift.most <= 0.25 * skin_ * skin_ || findMovers(x, centre)) return false;
+    return staleAfterAffineFit(x, mean);
 }
 
 // The displacement since the build fitted by least squares as u = mean + G (X - centre), with
@@ -357,9 +371,7 @@ void Contact::buildList(const SheetState& s) {
         }
     // Triangles stretched far past their rest size (a rubber film about a hole) would widen
     // every query: they get a hash of their own, with cells of their own reach.
-    std::vector<int> usual, stretched;
-    for (std::size_t k = 0; k < radii.size(); ++k)
-        (radii[k] > kStretchedTriangle * restWidest_ ? stretched : usual).push_back(int(k));
+    const auto [usual, stretched] = splitStretched(radii);
     const TriangleHash usualHash(*this, usual, centres, radii, kept, reach);
     const TriangleHash stretchedHash(*this, stretched, centres, radii, kept, reach);
     const PointHash points(searchedAt, reach);
@@ -410,6 +422,10 @@ void Contact::buildList(const SheetState& s) {
             if (active[std::size_t(i)] == 1) candidates(i, mine);
     }
     storeList(n, found);
+    clearMovers();
+    allUsual_.reset();
+    allStretched_.reset();
+    allPoints_.reset();
     builtAt_.assign(s.x.begin(), s.x.end());
     drift_ = 0.0;
     lastMean_ = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
@@ -417,6 +433,13 @@ void Contact::buildList(const SheetState& s) {
     ++builds_;
     sizeNextSkin();
     buildSeconds_ += omp_get_wtime() - started;
+}
+
+std::array<std::vector<int>, 2> Contact::splitStretched(std::span<const double> radii) const {
+    std::array<std::vector<int>, 2> split;
+    for (std::size_t k = 0; k < radii.size(); ++k)
+        split[radii[k] > kStretchedTriangle * restWidest_ ? 1 : 0].push_back(int(k));
+    return split;
 }
 
 // The candidates as CSR lists, each particle's particles first, then its triangles nearest
@@ -492,37 +515,57 @@ Eigen::Vector3d Contact::contactForce(int i, const std::array<int, 3>& tri,
     return force;
 }
 
+void Contact::considerTriangle(int i, int t, const SheetState& s, double& best,
+                               PointContact& contact, Eigen::Vector3d& closest) const {
+    if (!s.kept.empty() && !s.kept[std::size_t(t)]) return;  // torn since the build
+    const auto& tri = triangles_[std::size_t(t)];
+    const TrianglePoint c = closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+    const Eigen::Vector3d point = c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
+    const double d2 = (s.x[i] - point).squaredNorm();
+    if (d2 >= best) return;
+    best = d2;
+    contact.triangle = t;
+    contact.weights = c.weights;
+    closest = point;
+}
+
+void Contact::considerPoint(int i, int j, const SheetState& s, PointContact& contact) const {
+    if ((s.x[i] - s.x[j]).squaredNorm() >= thickness_ * thickness_) return;
+    contact.pointForce += contactForce(i, {j, j, j}, Eigen::Vector3d(1, 0, 0), s.x[j], s);
+    ++contact.points;
+}
+
 // Particle i against its list: the nearest triangle within d, whose corners take the force back
 // (scattered later), and every particle within d, whose own list holds i and computes the
-// opposite force with the same arithmetic (gathered here).
-Contact::PointContact Contact::nearestContact(int i, const SheetState& s) const {
+// opposite force with the same arithmetic (gathered here). With movers, a mover's list is not
+// read, nor the entries of others that hold a mover: its fresh candidates (`extra`) cover them.
+template <bool kMovers>
+Contact::PointContact Contact::nearestContact(int i, const SheetState& s,
+                                              std::span<const int> extra) const {
     PointContact contact;
     double best = thickness_ * thickness_;
     Eigen::Vector3d closest;
-    for (int k = listStart_[std::size_t(i)]; k < listStart_[std::size_t(i) + 1]; ++k) {
+    for (const int t : extra) {
+        if (t < 0)
+            considerPoint(i, -t - 1, s, contact);
+        else
+            considerTriangle(i, t, s, best, contact, closest);
+    }
+    const bool readList = !kMovers || !isMover_[std::size_t(i)];
+    for (int k = listStart_[std::size_t(i)]; readList && k < listStart_[std::size_t(i) + 1]; ++k) {
         const int t = list_[std::size_t(k)];
-        // Nothing since the build moved more than drift_ relative to the mean motion, so no
-        // point of a triangle closed on i by more than twice that; the rest of the list was
-        // farther at the build.
+        // Nothing since the build moved more than drift_ relative to the mean motion (movers
+        // aside), so no point of a triangle closed on i by more than twice that; the rest of
+        // the list was farther at the build.
         const double nearest = double(listDistance_[std::size_t(k)]) - 2.0 * drift_;
         if (t >= 0 && nearest > 0.0 && nearest * nearest >= best) break;
         if (t < 0) {
-            const int j = -t - 1;
-            if ((s.x[i] - s.x[j]).squaredNorm() >= thickness_ * thickness_) continue;
-            contact.pointForce += contactForce(i, {j, j, j}, Eigen::Vector3d(1, 0, 0), s.x[j], s);
-            ++contact.points;
+            if (kMovers && isMover_[std::size_t(-t - 1)]) continue;
+            considerPoint(i, -t - 1, s, contact);
             continue;
         }
-        if (!s.kept.empty() && !s.kept[std::size_t(t)]) continue;  // torn since the build
-        const auto& tri = triangles_[std::size_t(t)];
-        const TrianglePoint c = closestOnTriangle(s.x[i], s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
-        const Eigen::Vector3d point = c.at(s.x[tri[0]], s.x[tri[1]], s.x[tri[2]]);
-        const double d2 = (s.x[i] - point).squaredNorm();
-        if (d2 >= best) continue;
-        best = d2;
-        contact.triangle = t;
-        contact.weights = c.weights;
-        closest = point;
+        if (kMovers && touchesMover_[std::size_t(t)]) continue;
+        considerTriangle(i, t, s, best, contact, closest);
     }
     if (contact.triangle >= 0)
         contact.force =
@@ -539,7 +582,7 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
         evaluations_ - builtAtEvaluation_ > 4 * kListSteps && skin_ > kSkinMin * thickness_;
     if (overdue || listStale(s.x)) buildList(s);
     pairs_ = 0;
-    if (listed_.empty()) return;  // nothing within reach of anything: no force to add
+    if (listed_.empty() && movers_.empty()) return;  // nothing within reach of anything
     const int n = int(s.x.size());
     double fastest = 0.0;  // squared
 #pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
@@ -547,13 +590,24 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     stiffnessRate_ =
         std::max(baseStiffnessRate_, kStopping * kStopping * fastest / (thickness_ * thickness_));
     dampingRate_ = 2.0 * kContactDamping * std::sqrt(stiffnessRate_);
-    const int listed = int(listed_.size());
-    contacts_.resize(listed_.size());
+    if (!movers_.empty()) {
+        findMoverCandidates(s);
+        ++moverEvaluations_;
+    }
+    const std::span<const int> order = movers_.empty() ? listed_ : order_;
+    const int listed = int(order.size());
+    contacts_.resize(order.size());
     std::size_t pairs = 0;
 #pragma omp parallel for schedule(static) reduction(+ : pairs) if (listed >= kParallelThreshold)
     for (int k = 0; k < listed; ++k) {
-        const int i = listed_[std::size_t(k)];
-        const PointContact& c = contacts_[std::size_t(k)] = nearestContact(i, s);
+        const int i = order[std::size_t(k)];
+        const PointContact& c = contacts_[std::size_t(k)] =
+            movers_.empty() ? nearestContact<false>(i, s, {})
+                            : nearestContact<true>(i, s,
+                                                   std::span<const int>(extra_).subspan(
+                                                       std::size_t(orderExtra_[std::size_t(k)]),
+                                                       std::size_t(orderExtra_[std::size_t(k) + 1] -
+                                                                   orderExtra_[std::size_t(k)])));
         force[std::size_t(i)] += c.pointForce;
         pairs += std::size_t(c.points);
         if (c.triangle < 0) continue;

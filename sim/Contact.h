@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -97,6 +98,8 @@ public:
     /// Candidate-list rebuilds so far, and the wall seconds they took.
     long listBuilds() const { return builds_; }
     double listBuildSeconds() const { return buildSeconds_; }
+    /// Force evaluations that kept the list and followed movers (ContactMovers.cpp) instead.
+    long moverEvaluations() const { return moverEvaluations_; }
     /// Particles the last build searched (the rest were certified apart from anything not
     /// bonded to them at rest).
     int lastSearched() const { return lastActive_; }
@@ -156,7 +159,29 @@ private:
     bool bondedAtRest(int i, const std::array<int, 3>& tri,
                       std::span<const Eigen::Vector3d> rest) const;
     std::uint32_t bucketOf(const Eigen::Vector3i& cell) const;
-    PointContact nearestContact(int i, const SheetState& s) const;
+    /// Particle i against its list and `extra` (candidates of this evaluation, found afresh).
+    /// kMovers: skip what the movers' fresh candidates cover instead (ContactMovers.cpp).
+    template <bool kMovers>
+    PointContact nearestContact(int i, const SheetState& s, std::span<const int> extra) const;
+    /// Whether triangle t is nearer particle i than `best` (squared); if so, records it.
+    void considerTriangle(int i, int t, const SheetState& s, double& best, PointContact& contact,
+                          Eigen::Vector3d& closest) const;
+    void considerPoint(int i, int j, const SheetState& s, PointContact& contact) const;
+
+    // ---- movers (ContactMovers.cpp) ----
+    /// Sets movers_ to the particles that drifted more than skin / 2 from `centre` since the
+    /// build, and drift_ to the most any other did; false (and no movers) when they are too many.
+    bool findMovers(std::span<const Eigen::Vector3d> x, const Eigen::Vector3d& centre);
+    void clearMovers();
+    /// This evaluation's candidates of the movers and of their triangles, found afresh, and
+    /// the evaluation's particles with them (order_, orderExtra_, extra_).
+    void findMoverCandidates(const SheetState& s);
+    void addMoverTriangleCandidates(const SheetState& s, std::vector<std::array<int, 2>>& pairs);
+    /// Hashes of every particle and kept triangle at the build's positions, built at most once
+    /// a build, when movers first appear.
+    void buildMoverHashes(const SheetState& s);
+    /// The kept triangles `which` split by size: the usual, and the stretched (kStretchedTriangle).
+    std::array<std::vector<int>, 2> splitStretched(std::span<const double> radii) const;
     Eigen::Vector3d contactForce(int i, const std::array<int, 3>& tri, const Eigen::Vector3d& w,
                                  const Eigen::Vector3d& closest, const SheetState& s) const;
 
@@ -199,10 +224,25 @@ private:
     double drift_ = 0.0;
     /// The mean displacement since the build at the last two evaluations (listStale).
     std::array<Eigen::Vector3d, 2> lastMean_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-    std::vector<int> listed_;             ///< the particles whose lists are not empty, ascending
+    std::vector<int> listed_;  ///< the particles whose lists are not empty, ascending
+    /// Movers: particles that drifted more than skin / 2 since the build while the rest did not.
+    /// Their candidates, and those of particles near their triangles, are found afresh at each
+    /// evaluation (ContactMovers.cpp), and the list is kept for the rest.
+    std::vector<int> movers_;                 ///< ascending
+    std::vector<std::uint8_t> isMover_;       ///< per particle
+    std::vector<int> moverTriangles_;         ///< kept triangles with a mover corner, ascending
+    std::vector<std::uint8_t> touchesMover_;  ///< per triangle
+    Eigen::Vector3d moverCentre_ = Eigen::Vector3d::Zero();   ///< the common displacement
+    std::vector<int> vertexTriangleStart_, vertexTriangles_;  ///< each particle's triangles
+    std::unique_ptr<TriangleHash> allUsual_, allStretched_;   ///< buildMoverHashes
+    std::unique_ptr<PointHash> allPoints_;
+    double allPointsReach_ = 0.0;
+    /// The particles evaluated (listed or with fresh candidates), ascending, and each one's
+    /// fresh candidates (CSR into extra_; targets as in list_).
+    std::vector<int> order_, orderExtra_, extra_;
     std::vector<PointContact> contacts_;  ///< per listed particle, this evaluation's
     std::size_t pairs_ = 0;
-    long builds_ = 0;
+    long builds_ = 0, moverEvaluations_ = 0;
 };
 
 }  // namespace rend::sim

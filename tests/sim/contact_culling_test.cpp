@@ -387,3 +387,54 @@ TEST(ContactCulling, AKeptListStopsAtTheSameNearestTriangleAsAFreshOne) {
     EXPECT_GT(touching, 400u);         // the layers touch
     EXPECT_LT(kept.listBuilds(), 20);  // and the list was kept across frames
 }
+
+// A patch of the upper layer of a fold slides fast over the lower one and a lone particle rises
+// through both layers, while the rest of the sheet keeps still: the list is kept, the movers'
+// contacts are found afresh, and the forces are those of a list built afresh at each evaluation.
+TEST(ContactCulling, MoversFoundAfreshGiveTheForcesOfAFreshList) {
+    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
+    ContactParams params;
+    params.self.enabled = true;
+    const double d = 0.5 * kDx;
+    Contact kept(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+    const int n = int(s.rest().size());
+    const std::vector<double> mass(std::size_t(n), 1.0);
+    const std::vector<Eigen::Vector3d> v(std::size_t(n), Eigen::Vector3d::Zero());
+    const Eigen::Vector3d patch(0.06, 0.03, 0.0), lone(-0.07, -0.04, 0.0);
+    int loneParticle = 0;
+    for (int i = 0; i < n; ++i)
+        if ((s.rest()[std::size_t(i)] - lone).norm() <
+            (s.rest()[std::size_t(loneParticle)] - lone).norm())
+            loneParticle = i;
+    std::size_t touching = 0;
+    for (int frame = 0; frame <= 40; ++frame) {
+        const Eigen::Vector3d moved(0.6 * d * std::sin(0.4 * frame), 0.3 * d * frame, 0.0);
+        std::vector<Eigen::Vector3d> x =
+            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+                if (p.x() <= 0.0) return p;
+                const double r = 0.4 * d, a = std::min(p.x() / r, M_PI);
+                const double beyond = std::max(0.0, p.x() - M_PI * r);
+                const Eigen::Vector3d q(r * std::sin(a) - beyond, p.y(), r * (1 - std::cos(a)));
+                return (p - patch).norm() < 1.2 * kDx ? Eigen::Vector3d(q + moved) : q;
+            });
+        // Through the lower layer at z = 0 and the upper at 0.8 d, and on above them.
+        x[std::size_t(loneParticle)] = s.rest()[std::size_t(loneParticle)] +
+                                       Eigen::Vector3d(0.02, 0.0, -2.0 * d + 0.15 * d * frame);
+        std::vector<Eigen::Vector3d> fromKept(std::size_t(n), Eigen::Vector3d::Zero());
+        kept.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromKept);
+        Contact fresh(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+        std::vector<Eigen::Vector3d> fromFresh(std::size_t(n), Eigen::Vector3d::Zero());
+        fresh.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromFresh);
+        ASSERT_EQ(kept.lastPairCount(), fresh.lastPairCount()) << "frame " << frame;
+        ASSERT_EQ(kept.lastPairCount(), contactsByBruteForce(s, x, d)) << "frame " << frame;
+        double largest = 0.0;
+        for (const Eigen::Vector3d& f : fromFresh) largest = std::max(largest, f.norm());
+        for (int i = 0; i < n; ++i)
+            ASSERT_LE((fromKept[std::size_t(i)] - fromFresh[std::size_t(i)]).norm(), 1e-9 * largest)
+                << "particle " << i << ", frame " << frame;
+        touching = std::max(touching, kept.lastPairCount());
+    }
+    EXPECT_GT(touching, 200u);               // the layers touch
+    EXPECT_GT(kept.moverEvaluations(), 25);  // the movers were followed
+    EXPECT_LT(kept.listBuilds(), 8);         // and the list kept
+}

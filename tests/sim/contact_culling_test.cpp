@@ -105,6 +105,44 @@ std::vector<Eigen::Vector3d> deformed(const Sheet& s, const Deform& f) {
     return x;
 }
 
+/// A sheet with self-contact at d = dx / 2, unit masses and no velocities, whose kept list is
+/// compared with one built afresh at each evaluation.
+struct KeptAgainstFresh {
+    Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
+    ContactParams params = [] {
+        ContactParams p;
+        p.self.enabled = true;
+        return p;
+    }();
+    double d = 0.5 * kDx;
+    int n = int(s.rest().size());
+    std::vector<double> mass = std::vector<double>(std::size_t(n), 1.0);
+    std::vector<Eigen::Vector3d> v =
+        std::vector<Eigen::Vector3d>(std::size_t(n), Eigen::Vector3d::Zero());
+    Contact kept = make();
+
+    Contact make() const {
+        return Contact(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
+    }
+    std::vector<Eigen::Vector3d> forces(Contact& c, std::span<const Eigen::Vector3d> x) const {
+        std::vector<Eigen::Vector3d> f(std::size_t(n), Eigen::Vector3d::Zero());
+        c.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, f);
+        return f;
+    }
+    /// The kept list's forces at x against a fresh list's, to 1e-9 of the largest.
+    void expectFreshForces(std::span<const Eigen::Vector3d> x, int frame) {
+        const std::vector<Eigen::Vector3d> fromKept = forces(kept, x);
+        Contact fresh = make();
+        const std::vector<Eigen::Vector3d> fromFresh = forces(fresh, x);
+        ASSERT_EQ(kept.lastPairCount(), fresh.lastPairCount()) << "frame " << frame;
+        double largest = 0.0;
+        for (const Eigen::Vector3d& f : fromFresh) largest = std::max(largest, f.norm());
+        for (int i = 0; i < n; ++i)
+            ASSERT_LE((fromKept[std::size_t(i)] - fromFresh[std::size_t(i)]).norm(), 1e-9 * largest)
+                << "particle " << i << ", frame " << frame;
+    }
+};
+
 }  // namespace
 
 TEST(ContactCulling, RestClearanceIsTheNearestUnbondedParticleOrTriangle) {
@@ -348,21 +386,15 @@ TEST(ContactCulling, StretchedTrianglesLaidOverTheSheetAreFound) {
 // across evaluations gives the forces of a list built afresh at each one, while a folded layer
 // slides and ripples over the other.
 TEST(ContactCulling, AKeptListStopsAtTheSameNearestTriangleAsAFreshOne) {
-    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
-    ContactParams params;
-    params.self.enabled = true;
-    const double d = 0.5 * kDx;
-    Contact kept(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
-    const int n = int(s.rest().size());
-    const std::vector<double> mass(std::size_t(n), 1.0);
-    const std::vector<Eigen::Vector3d> v(std::size_t(n), Eigen::Vector3d::Zero());
+    KeptAgainstFresh rig;
+    const double d = rig.d;
     std::size_t touching = 0;
     for (int frame = 0; frame <= 40; ++frame) {
         // Folded over at x = 0, the upper layer 0.8 d above the lower, sliding along y and
         // rippling as it goes.
         const double slide = 0.03 * kDx * frame, phase = 0.3 * frame;
         const std::vector<Eigen::Vector3d> x =
-            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+            deformed(rig.s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
                 if (p.x() <= 0.0) return p;
                 const double r = 0.4 * d, a = std::min(p.x() / r, M_PI);
                 const double beyond = std::max(0.0, p.x() - M_PI * r);
@@ -371,46 +403,30 @@ TEST(ContactCulling, AKeptListStopsAtTheSameNearestTriangleAsAFreshOne) {
                 return {r * std::sin(a) - beyond, p.y() + along,
                         r * (1 - std::cos(a)) + (beyond > 0.0 ? ripple : 0.0)};
             });
-        std::vector<Eigen::Vector3d> fromKept(std::size_t(n), Eigen::Vector3d::Zero());
-        kept.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromKept);
-        Contact fresh(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
-        std::vector<Eigen::Vector3d> fromFresh(std::size_t(n), Eigen::Vector3d::Zero());
-        fresh.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromFresh);
-        ASSERT_EQ(kept.lastPairCount(), fresh.lastPairCount()) << "frame " << frame;
-        double largest = 0.0;
-        for (const Eigen::Vector3d& f : fromFresh) largest = std::max(largest, f.norm());
-        for (int i = 0; i < n; ++i)
-            ASSERT_LE((fromKept[std::size_t(i)] - fromFresh[std::size_t(i)]).norm(), 1e-9 * largest)
-                << "particle " << i << ", frame " << frame;
-        touching = std::max(touching, kept.lastPairCount());
+        ASSERT_NO_FATAL_FAILURE(rig.expectFreshForces(x, frame));
+        touching = std::max(touching, rig.kept.lastPairCount());
     }
-    EXPECT_GT(touching, 400u);         // the layers touch
-    EXPECT_LT(kept.listBuilds(), 20);  // and the list was kept across frames
+    EXPECT_GT(touching, 400u);             // the layers touch
+    EXPECT_LT(rig.kept.listBuilds(), 20);  // and the list was kept across frames
 }
 
 // A patch of the upper layer of a fold slides fast over the lower one and a lone particle rises
 // through both layers, while the rest of the sheet keeps still: the list is kept, the movers'
 // contacts are found afresh, and the forces are those of a list built afresh at each evaluation.
 TEST(ContactCulling, MoversFoundAfreshGiveTheForcesOfAFreshList) {
-    const Sheet s = makeSheet(LatticeKind::Hexagonal, {0.2, 0.12});
-    ContactParams params;
-    params.self.enabled = true;
-    const double d = 0.5 * kDx;
-    Contact kept(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
-    const int n = int(s.rest().size());
-    const std::vector<double> mass(std::size_t(n), 1.0);
-    const std::vector<Eigen::Vector3d> v(std::size_t(n), Eigen::Vector3d::Zero());
+    KeptAgainstFresh rig;
+    const double d = rig.d;
     const Eigen::Vector3d patch(0.06, 0.03, 0.0), lone(-0.07, -0.04, 0.0);
     int loneParticle = 0;
-    for (int i = 0; i < n; ++i)
-        if ((s.rest()[std::size_t(i)] - lone).norm() <
-            (s.rest()[std::size_t(loneParticle)] - lone).norm())
+    for (int i = 0; i < rig.n; ++i)
+        if ((rig.s.rest()[std::size_t(i)] - lone).norm() <
+            (rig.s.rest()[std::size_t(loneParticle)] - lone).norm())
             loneParticle = i;
     std::size_t touching = 0;
     for (int frame = 0; frame <= 40; ++frame) {
         const Eigen::Vector3d moved(0.6 * d * std::sin(0.4 * frame), 0.3 * d * frame, 0.0);
         std::vector<Eigen::Vector3d> x =
-            deformed(s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+            deformed(rig.s, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
                 if (p.x() <= 0.0) return p;
                 const double r = 0.4 * d, a = std::min(p.x() / r, M_PI);
                 const double beyond = std::max(0.0, p.x() - M_PI * r);
@@ -418,23 +434,13 @@ TEST(ContactCulling, MoversFoundAfreshGiveTheForcesOfAFreshList) {
                 return (p - patch).norm() < 1.2 * kDx ? Eigen::Vector3d(q + moved) : q;
             });
         // Through the lower layer at z = 0 and the upper at 0.8 d, and on above them.
-        x[std::size_t(loneParticle)] = s.rest()[std::size_t(loneParticle)] +
+        x[std::size_t(loneParticle)] = rig.s.rest()[std::size_t(loneParticle)] +
                                        Eigen::Vector3d(0.02, 0.0, -2.0 * d + 0.15 * d * frame);
-        std::vector<Eigen::Vector3d> fromKept(std::size_t(n), Eigen::Vector3d::Zero());
-        kept.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromKept);
-        Contact fresh(params, d, 1.5 * kDx, 1.0, s.lattice.triangles, s.rest());
-        std::vector<Eigen::Vector3d> fromFresh(std::size_t(n), Eigen::Vector3d::Zero());
-        fresh.addSelfContactForces({x, v, s.rest(), mass, {}, 1e-3}, fromFresh);
-        ASSERT_EQ(kept.lastPairCount(), fresh.lastPairCount()) << "frame " << frame;
-        ASSERT_EQ(kept.lastPairCount(), contactsByBruteForce(s, x, d)) << "frame " << frame;
-        double largest = 0.0;
-        for (const Eigen::Vector3d& f : fromFresh) largest = std::max(largest, f.norm());
-        for (int i = 0; i < n; ++i)
-            ASSERT_LE((fromKept[std::size_t(i)] - fromFresh[std::size_t(i)]).norm(), 1e-9 * largest)
-                << "particle " << i << ", frame " << frame;
-        touching = std::max(touching, kept.lastPairCount());
+        ASSERT_NO_FATAL_FAILURE(rig.expectFreshForces(x, frame));
+        ASSERT_EQ(rig.kept.lastPairCount(), contactsByBruteForce(rig.s, x, d)) << "frame " << frame;
+        touching = std::max(touching, rig.kept.lastPairCount());
     }
-    EXPECT_GT(touching, 200u);               // the layers touch
-    EXPECT_GT(kept.moverEvaluations(), 25);  // the movers were followed
-    EXPECT_LT(kept.listBuilds(), 8);         // and the list kept
+    EXPECT_GT(touching, 200u);                   // the layers touch
+    EXPECT_GT(rig.kept.moverEvaluations(), 25);  // the movers were followed
+    EXPECT_LT(rig.kept.listBuilds(), 8);         // and the list kept
 }

@@ -22,11 +22,12 @@
 //   of triangle centroids into a list padded by a skin,
 //   rebuilt only once some particle has moved half the skin since, relative to the mean motion,
 //   and the affine motion fitted since the build cannot vouch for it either (a sheet drawn
-//   apart keeps its list; Contact::staleAfterAffineFit) (a Verlet list). The skin adapts so that a
-//   list lasts about 24 steps, up to a cap that leaves the culling room (Contact.cpp). The
-//   penalty's stiffness per unit mass is at least the base rate (Membrane: enough to hold a pile of
-//   sheets under gravity within d / 4) and grows with the fastest particle's speed, so that no
-//   approach at the scene's speeds closes past d / 2.
+//   apart keeps its list; Contact::staleAfterAffineFit) (a Verlet list); a few particles that
+//   outran the skin while the rest did not are followed afresh instead (ContactMovers.cpp). The
+//   skin adapts so that a list lasts about 24 steps, up to a cap that leaves the culling room
+//   (Contact.cpp). The penalty's stiffness per unit mass is at least the base rate (Membrane:
+//   enough to hold a pile of sheets under gravity within d / 4) and grows with the fastest
+//   particle's speed, so that no approach at the scene's speeds closes past d / 2.
 // - The step limit: with self-contact, no two particles close by more than d / 4 in a step
 //   (dt <= d / (4 (2 max|v|))), and no particle moves past half a collider's thinnest part.
 

@@ -32,8 +32,9 @@ constexpr double kSkin = 1.0, kSkinMin = 0.25, kSkinMax = 2.0;
 constexpr long kListSteps = 24;
 /// ContactCulling's tiles, in units of the bond reach: wide enough that tiles two apart are
 /// told apart by their bounding spheres, narrow enough that a gently bent sheet fits an affine
-/// map over three of them.
-constexpr double kTileSize = 3.0;
+/// map over three of them (a bend's residual grows as the square of that width: film_poke at
+/// dx = 0.01 spent 14% less in list builds with 2 than with 3; foil_drape and towel_pile the same).
+constexpr double kTileSize = 2.0;
 constexpr double kCullingReach = 0.6;
 /// A triangle whose centroid is this many times farther from a corner than the widest at rest
 /// goes into the stretched triangles' hash.

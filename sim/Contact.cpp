@@ -74,6 +74,8 @@ Contact::Contact(const ContactParams& params, double thickness, double horizon,
     skin_ = kSkin * thickness_;
     if (params_.self.enabled) setUpTriangles(triangles, rest, reach);
     meshes_.resize(params_.colliders.size());
+    for (const ColliderParams& collider : params_.colliders)
+        colliderReach2_.push_back(std::pow(boundingRadius(collider) + offset_, 2));
     for (std::size_t c = 0; c < params_.colliders.size(); ++c) {
         const ColliderParams& collider = params_.colliders[c];
         // Reach: the offset and a step's worth of approach (stepLimit keeps it under 2 d).
@@ -144,6 +146,8 @@ void Contact::resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const {
     for (std::size_t c = 0; c < poses_.size(); ++c) {
         const ColliderParams& collider = params_.colliders[c];
         const ColliderPose& pose = poses_[c];
+        // Beyond its bounding sphere by the offset: no surface within the offset.
+        if ((x - pose.position).squaredNorm() >= colliderReach2_[c]) continue;
         const std::optional<SurfaceDistance> local =
             signedDistance(collider, meshes_[c] ? &*meshes_[c] : nullptr, pose.toLocal(x));
         if (!local || local->distance >= offset_) continue;

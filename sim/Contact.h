@@ -193,6 +193,7 @@ private:
     double stiffnessRate_ = 0.0, dampingRate_ = 0.0;   ///< this evaluation's, from the speeds
     std::vector<std::optional<MeshDistance>> meshes_;  ///< per collider, for meshes
     std::vector<ColliderPose> poses_;
+    std::vector<double> colliderReach2_;  ///< per collider: (bounding radius + offset)^2
     Eigen::Vector3d impulse_ = Eigen::Vector3d::Zero();  ///< the last resolve's momentum change
     double work_ = 0.0;                                  ///< takeWork's sum
     /// The fastest collider point at the current poses [m/s].

@@ -138,7 +138,8 @@ constexpr Param kMaterial[] = {
      T::Choice,
      {},
      "\"calibrated\"",
-     "how the critical stretch follows from G_f (\"paper\": eq. 28 as printed)",
+     "how the critical stretch follows from G_f (\"paper\": eq. 28 as printed; \"preview\": the "
+     "preview spacing's at every quality)",
      "\"calibrated\"",
      names::kCriticalStretches},
     {"strength_loss", T::Number, closed(0.0, 1e6), "0",

@@ -34,6 +34,14 @@ double paperCriticalStretch(double fractureEnergy, double youngsModulus, double 
     return std::sqrt(4.0 * std::numbers::pi * fractureEnergy / (9.0 * youngsModulus * horizon));
 }
 
+MembraneParams withPreviewStrength(MembraneParams params) {
+    MaterialParams& m = params.material;
+    const double preview = params.sheet.seedSpacing;
+    if (m.criticalStretch == CriticalStretchMode::Preview && m.fractureEnergy && preview > 0.0)
+        *m.fractureEnergy *= params.sheet.dx / preview;
+    return params;
+}
+
 namespace {
 
 double orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {

@@ -30,6 +30,11 @@ double calibratedCriticalStretch(double fractureEnergy, double micromodulus,
 /// Eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R)).
 double paperCriticalStretch(double fractureEnergy, double youngsModulus, double horizon);
 
+/// params with critical_stretch = "preview" resolved: every solver's critical strain goes as
+/// sqrt(G_f / dx) at a fixed horizon factor, so G_f dx / dx_preview breaks this spacing's bonds at
+/// the preview's strain. Unchanged in the other modes, or at the preview spacing.
+MembraneParams withPreviewStrength(MembraneParams params);
+
 /// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
 /// lattice row store the fracture energy G_f (infinity without one).
 double springCriticalStrain(const MembraneParams& params);

@@ -14,8 +14,9 @@
 
 namespace rend::sim {
 
-Membrane::Membrane(const MembraneParams& params)
-    : params_(params), lattice_(generateLattice(params.sheet)) {
+Membrane::Membrane(const MembraneParams& given)
+    : params_(withPreviewStrength(given)), lattice_(generateLattice(given.sheet)) {
+    const MembraneParams& params = params_;
     const SheetParams& sheet = params.sheet;
     horizon_ = sheet.horizonFactor * sheet.dx;
     x0_ = lattice_.positions;

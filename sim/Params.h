@@ -65,6 +65,10 @@ enum class BondLawKind {
 enum class CriticalStretchMode {
     Calibrated,  ///< the energy of the bonds crossing a unit crack equals G_f (see Fracture.h)
     Paper,       ///< eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R))
+    /// The calibrated eta_c of the preview spacing (SheetParams::seedSpacing) at every spacing:
+    /// the sheet breaks at the same stretch at final quality as in its preview, where the
+    /// calibrated one grows as 1 / sqrt(dx) (withPreviewStrength).
+    Preview,
 };
 
 struct MaterialParams {

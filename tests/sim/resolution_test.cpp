@@ -8,6 +8,7 @@
 
 #include "sim/Lattice.h"
 #include "sim/Membrane.h"
+#include "tests/sim/Peridynamic.h"
 
 using namespace rend::sim;
 
@@ -109,4 +110,26 @@ TEST(Resolution, TheJitterIsTheSameSurfaceSampledFiner) {
     EXPECT_LT(seeded, 2.0 * own);
     EXPECT_GT(rough, 3.0 * own);
     for (const double z : zf) EXPECT_LE(std::abs(z), coarse.perturbationAmplitude);
+}
+
+// critical_stretch = "preview": a sheet breaks at the same stretch at every spacing (a strength),
+// where the calibrated eta_c grows as 1 / sqrt(dx) at a fixed horizon factor. The bonds of a
+// finer lattice, and the continuum's reference value, break at the preview's stretch.
+TEST(Resolution, APreviewStrengthBreaksAtThePreviewsStretchAtEverySpacing) {
+    const auto etaAt = [](double dx, CriticalStretchMode mode) {
+        MembraneParams p = sheetAt(dx, 0.05);
+        p.material.fractureEnergy = 5.0;
+        p.material.criticalStretch = mode;
+        const Membrane m(p);
+        return std::pair{rend::test::criticalStretch(m), m.referenceCriticalStretch()};
+    };
+    const auto [calibrated, calibratedReference] = etaAt(0.05, CriticalStretchMode::Calibrated);
+    const auto [finer, finerReference] = etaAt(0.025, CriticalStretchMode::Calibrated);
+    EXPECT_NEAR(finer / calibrated, std::sqrt(2.0), 1e-9);
+    EXPECT_NEAR(finerReference / calibratedReference, std::sqrt(2.0), 1e-9);
+    for (const double dx : {0.05, 0.025, 0.0125 * 1.6}) {
+        const auto [preview, reference] = etaAt(dx, CriticalStretchMode::Preview);
+        EXPECT_NEAR(preview / calibrated, 1.0, 1e-9) << "dx " << dx;
+        EXPECT_NEAR(reference / calibratedReference, 1.0, 1e-9) << "dx " << dx;
+    }
 }

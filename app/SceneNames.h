@@ -16,7 +16,8 @@ inline constexpr std::string_view kLattices[] = {"hexagonal", "square"};
 inline constexpr std::string_view kQualities[] = {"preview", "final"};  // rend::Quality
 inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
-inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper", "preview"};
+inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper", "preview",
+                                                          "midway"};
 inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 inline constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
 inline constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};

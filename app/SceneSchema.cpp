@@ -130,7 +130,9 @@ constexpr Param kMaterial[] = {
      "the exponent n of the power law, eq. 19", "4"},
     {"yield_strain", T::Number, positive(10.0), "1e-4", "the elastic limit eta0 of eqs. 20 and 27",
      "1e-4"},
-    {"softening", T::Number, positive(1e6), "1", "beta of eqs. 20 and 27, the post-yield decay",
+    {"softening", T::Number, positive(1e6), "1",
+     "beta of eqs. 20 and 27, the post-yield decay, at the preview spacing (a crack band scales it "
+     "with dx / dx_preview at final quality)",
      "1.0"},
     {"fracture_energy", T::NumberOrWord, positive(1e9), "\"none\" (unbreakable)",
      "the fracture energy G_f in J/m^2", "11.3", names::kNone},
@@ -139,7 +141,7 @@ constexpr Param kMaterial[] = {
      {},
      "\"calibrated\"",
      "how the critical stretch follows from G_f (\"paper\": eq. 28 as printed; \"preview\": the "
-     "preview spacing's at every quality)",
+     "preview spacing's at every quality; \"midway\": the geometric mean of the two)",
      "\"calibrated\"",
      names::kCriticalStretches},
     {"strength_loss", T::Number, closed(0.0, 1e6), "0",

@@ -37,8 +37,17 @@ double paperCriticalStretch(double fractureEnergy, double youngsModulus, double 
 MembraneParams withPreviewStrength(MembraneParams params) {
     MaterialParams& m = params.material;
     const double preview = params.sheet.seedSpacing;
-    if (m.criticalStretch == CriticalStretchMode::Preview && m.fractureEnergy && preview > 0.0)
-        *m.fractureEnergy *= params.sheet.dx / preview;
+    if (!m.fractureEnergy || preview <= 0.0) return params;
+    const double finer = params.sheet.dx / preview;
+    if (m.criticalStretch == CriticalStretchMode::Preview) *m.fractureEnergy *= finer;
+    if (m.criticalStretch == CriticalStretchMode::Midway) *m.fractureEnergy *= std::sqrt(finer);
+    return params;
+}
+
+MembraneParams withCrackBandSoftening(MembraneParams params) {
+    const double preview = params.sheet.seedSpacing;
+    if (params.material.law == BondLawKind::Elastoplastic && preview > 0.0)
+        params.material.softening *= params.sheet.dx / preview;
     return params;
 }
 

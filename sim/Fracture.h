@@ -30,10 +30,18 @@ double calibratedCriticalStretch(double fractureEnergy, double micromodulus,
 /// Eq. 28 as printed: eta_c = sqrt(4 pi G_f / (9 E R)).
 double paperCriticalStretch(double fractureEnergy, double youngsModulus, double horizon);
 
-/// params with critical_stretch = "preview" resolved: every solver's critical strain goes as
-/// sqrt(G_f / dx) at a fixed horizon factor, so G_f dx / dx_preview breaks this spacing's bonds at
-/// the preview's strain. Unchanged in the other modes, or at the preview spacing.
+/// params with critical_stretch = "preview" or "midway" resolved: every solver's critical strain
+/// goes as sqrt(G_f / dx) at a fixed horizon factor, so G_f dx / dx_preview breaks this spacing's
+/// bonds at the preview's strain, and G_f sqrt(dx / dx_preview) at the geometric mean of that
+/// and the calibrated strain. Unchanged in the other modes, or at the preview spacing.
 MembraneParams withPreviewStrength(MembraneParams params);
+
+/// params with the elastoplastic softening (eq. 20's beta) given at the preview spacing held to
+/// the same energy per unit crack area at this one (a crack band, Bazant and Oh 1983): a
+/// softening law localises its strain in one row of bonds, whose work past the yield,
+/// eta0^2 / beta for each bond, must then grow as 1 / dx, so beta scales with dx / dx_preview.
+/// Unchanged for the other laws, or at the preview spacing.
+MembraneParams withCrackBandSoftening(MembraneParams params);
 
 /// Critical strain of the spring and FEM solvers: the springs crossing a unit crack along a
 /// lattice row store the fracture energy G_f (infinity without one).

@@ -15,7 +15,8 @@
 namespace rend::sim {
 
 Membrane::Membrane(const MembraneParams& given)
-    : params_(withPreviewStrength(given)), lattice_(generateLattice(given.sheet)) {
+    : params_(withCrackBandSoftening(withPreviewStrength(given))),
+      lattice_(generateLattice(given.sheet)) {
     const MembraneParams& params = params_;
     const SheetParams& sheet = params.sheet;
     horizon_ = sheet.horizonFactor * sheet.dx;

@@ -69,6 +69,10 @@ enum class CriticalStretchMode {
     /// the sheet breaks at the same stretch at final quality as in its preview, where the
     /// calibrated one grows as 1 / sqrt(dx) (withPreviewStrength).
     Preview,
+    /// The geometric mean of Calibrated and Preview: eta_c grows as dx^(-1/4) where the
+    /// calibrated one grows as dx^(-1/2). Tears that start where a sheet lands keep to a
+    /// strength (Preview); tears that run from a cut keep to an energy (Calibrated).
+    Midway,
 };
 
 struct MaterialParams {

@@ -133,3 +133,44 @@ TEST(Resolution, APreviewStrengthBreaksAtThePreviewsStretchAtEverySpacing) {
         EXPECT_NEAR(reference / calibratedReference, 1.0, 1e-9) << "dx " << dx;
     }
 }
+
+TEST(Resolution, AMidwayStrengthIsTheGeometricMeanOfTheCalibratedAndThePreviews) {
+    const auto etaAt = [](double dx, CriticalStretchMode mode) {
+        MembraneParams p = sheetAt(dx, 0.05);
+        p.material.fractureEnergy = 5.0;
+        p.material.criticalStretch = mode;
+        return rend::test::criticalStretch(Membrane(p));
+    };
+    const double preview = etaAt(0.05, CriticalStretchMode::Calibrated);
+    EXPECT_NEAR(etaAt(0.05, CriticalStretchMode::Midway) / preview, 1.0, 1e-9);
+    for (const double dx : {0.025, 0.0125 * 1.6}) {
+        const double calibrated = etaAt(dx, CriticalStretchMode::Calibrated);
+        EXPECT_NEAR(etaAt(dx, CriticalStretchMode::Midway), std::sqrt(calibrated * preview), 1e-12)
+            << "dx " << dx;
+        EXPECT_NEAR(etaAt(dx, CriticalStretchMode::Midway) / preview, std::pow(0.05 / dx, 0.25),
+                    1e-9)
+            << "dx " << dx;
+    }
+}
+
+// A softening law localises its strain in one row of bonds, so the work past the yield per unit
+// crack length must not shrink with the row: each bond's eta0^2 / beta times the bonds crossing a
+// unit crack (c S / pi, from the calibrated eta_c^2 = 2 pi G_f / (c S)) holds at every spacing.
+TEST(Resolution, TheSofteningTakesTheSameWorkPerUnitCrackAtEverySpacing) {
+    const auto softeningWork = [](double dx, double seedSpacing) {
+        MembraneParams p = sheetAt(dx, seedSpacing);
+        p.material.law = BondLawKind::Elastoplastic;
+        p.material.yieldStrain = 0.015;
+        p.material.softening = 0.06;
+        p.material.fractureEnergy = 5.0;
+        const Membrane m(p);
+        const double eta = rend::test::criticalStretch(m), eta0 = 0.015;
+        const double perBond = eta0 * eta0 / m.params().material.softening;
+        return *p.material.fractureEnergy * 2.0 * perBond / (eta * eta);
+    };
+    const double preview = softeningWork(0.05, 0.05);
+    for (const double dx : {0.025, 0.0125 * 1.6})
+        EXPECT_NEAR(softeningWork(dx, 0.05) / preview, 1.0, 1e-9) << "dx " << dx;
+    EXPECT_NEAR(softeningWork(0.025, 0.0) / preview, 0.5, 1e-9)
+        << "without a preview spacing the law is the one given, and a finer row takes less work";
+}

@@ -394,6 +394,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     try {
         for (int frame = 1; frame <= last; ++frame) {
             t0 = Clock::now();
+            membrane.startFrame();  // a frame's lists are its own: checkpoints resume exactly
             if (adaptive)
                 membrane.advanceTo(frame / time.fps);
             else

@@ -89,6 +89,12 @@ public:
     };
     Sample sample(const State& state) const;
 
+    /// What a checkpoint keeps (sim/StateArchive.h): the energy budget and the growth watch.
+    template <class Self, class Archive>
+    static void visitState(Self& s, Archive& a) {
+        a(s.budget_), a(s.started_), a(s.lastKinetic_), a(s.growingSteps_), a(s.growthProduct_);
+    }
+
 private:
     void sampleBlock(const State& state, int begin, int end, Sample& out) const;
     [[noreturn]] void report(const State& state, const Sample& s, const std::string& why) const;

@@ -91,6 +91,17 @@ public:
         work_ = 0.0;
         return w;
     }
+    /// Drops the self-contact's candidate list: the next force evaluation builds a fresh one.
+    /// Called at every frame's start, so that a checkpoint, which keeps no list, resumes with
+    /// the same bits as a run that never stopped.
+    void expireList() { builtAt_.clear(); }
+    /// What a checkpoint keeps (sim/StateArchive.h): the skin's history and the colliders'
+    /// work; the list itself is expired at each frame's start (expireList).
+    template <class Self, class Archive>
+    static void visitState(Self& s, Archive& a) {
+        a(s.skin_), a(s.evaluations_), a(s.builtAtEvaluation_), a(s.builds_);
+        a(s.moverEvaluations_), a(s.work_), a(s.impulse_);
+    }
     /// The momentum the ground and colliders gave the sheet in the last resolve [N s].
     Eigen::Vector3d lastImpulse() const { return impulse_; }
     /// Contacts within d at the last force evaluation: particle-triangle ones, and

@@ -79,6 +79,13 @@ public:
     /// Breaks the proposed bonds in index order and clears the buffer.
     void applyProposals();
 
+    /// What a checkpoint keeps (sim/StateArchive.h); the maps are rebuilt from the scene.
+    template <class Self, class Archive>
+    static void visitState(Self& s, Archive& a) {
+        a(s.bondAlive_), a(s.edgeAlive_), a(s.triangleAlive_), a(s.kept_), a(s.strength_);
+        a(s.brokenBonds_), a(s.removedTriangles_);
+    }
+
 private:
     void killEdge(int e);
 

@@ -72,6 +72,12 @@ public:
     /// principal stretch, looked ahead by dt at its current rate.
     void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
+    void saveState(StateWriter& out) const override {
+        out(plasticStrain_), out(maxStrain_), out(stiffening_);
+    }
+    void loadState(StateReader& in) override {
+        in(plasticStrain_), in(maxStrain_), in(stiffening_);
+    }
     /// A bond along an element side: the mean gamma of the living elements holding it; any
     /// other bond: the mean of its two ends' (each the mean over its living elements).
     void reportStrength(DamageState& damage) const override;

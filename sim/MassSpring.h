@@ -78,6 +78,8 @@ public:
     void fracture(const StepState& s, Workspace& work) override;
     void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
     double stiffening() const override { return stiffening_; }
+    void saveState(StateWriter& out) const override { out(plastic_), out(stiffening_); }
+    void loadState(StateReader& in) override { in(plastic_), in(stiffening_); }
     /// Each of the Membrane's bonds along a spring reports that spring's strength left.
     void reportStrength(DamageState& damage) const override;
 

@@ -28,6 +28,7 @@
 #include "sim/Params.h"
 #include "sim/Random.h"
 #include "sim/Solver.h"
+#include "sim/StateArchive.h"
 #include "sim/TimeStep.h"
 
 namespace rend::sim {
@@ -91,6 +92,18 @@ public:
     /// Adaptive stepping (time.dt = "adaptive", sim/TimeStep.h): steps until time() is exactly
     /// tEnd, each step from the controller, the last ones evened out to land on tEnd.
     void advanceTo(double tEnd);
+    /// At a frame's start: the self-contact's candidate list is rebuilt (Contact::expireList),
+    /// so that a run resumed from a checkpoint at this frame steps on with the same bits.
+    void startFrame() {
+        if (contact_) contact_->expireList();
+    }
+
+    /// The evolving state, for a checkpoint (sim/StateArchive.h): read back with loadState
+    /// into a membrane built from the same scene, it steps on with the same bits. Taken
+    /// between frames (after startFrame's frame ends, before the next one starts).
+    std::vector<std::byte> saveState() const;
+    /// Throws StateMismatch when `bytes` do not fit this membrane (another scene, truncated).
+    void loadState(std::span<const std::byte> bytes);
 
     /// The solver's internal forces on every particle (for the bonds, eq. 22 with the current
     /// bond direction), without changing any state.
@@ -170,6 +183,9 @@ private:
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
     std::size_t breakCount() const;
+    /// saveState's and loadState's fields, in order (sim/MembraneState.cpp).
+    template <class Self, class Archive>
+    static void visitState(Self& m, Archive& a);
 
     MembraneParams params_;
     Lattice lattice_;

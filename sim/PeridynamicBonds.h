@@ -41,6 +41,8 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const StepState& s, Workspace& work) const override;
     double stiffening() const override { return stiffening_; }
+    void saveState(StateWriter& out) const override { out(plastic_), out(stiffening_); }
+    void loadState(StateReader& in) override { in(plastic_), in(stiffening_); }
     void reportStrength(DamageState& damage) const override;
 
     const BondLaw& law() const { return law_; }

@@ -23,6 +23,7 @@
 
 #include "sim/Bonds.h"
 #include "sim/DamageState.h"
+#include "sim/StateArchive.h"
 
 namespace rend::sim {
 
@@ -85,6 +86,11 @@ public:
     /// the solver keeps in its own pieces (springs, elements); called once per frame, for the
     /// damage field. Nothing by default: every bond keeps full strength.
     virtual void reportStrength(DamageState& damage) const {}
+    /// The solver's own history (plastic strains, broken pieces) for a checkpoint
+    /// (sim/StateArchive.h), read back into a solver built from the same scene. Nothing by
+    /// default: a solver without history keeps it all in the DamageState.
+    virtual void saveState(StateWriter& out) const {}
+    virtual void loadState(StateReader& in) {}
 
     /// Set-up, before anything else: the Membrane's bonds and the DamageState the solver reads
     /// in forces() and changes in advance(); both outlive the solver.

@@ -61,6 +61,13 @@ public:
     /// The most bonds one step broke.
     std::size_t largestBurst() const { return largestBurst_; }
 
+    /// What a checkpoint keeps (sim/StateArchive.h).
+    template <class Self, class Archive>
+    static void visitState(Self& s, Archive& a) {
+        a(s.failureRate_), a(s.wanted_), a(s.cap_), a(s.burst_), a(s.lastLimit_), a(s.counts_);
+        a(s.largestBurst_);
+    }
+
 private:
     double safety_ = kMostOfBound;
     double burstBonds_ = 8;

@@ -78,6 +78,13 @@ public:
 
     /// Pairs broken by fracture so far (each counted once; notches not included).
     std::size_t brokenPairCount() const { return brokenPairs_; }
+    /// Broken pairs, their zeroed gradients and the damaged particles' rest metrics.
+    void saveState(StateWriter& out) const override {
+        out(pairAlive_), out(gradient_), out(restMetric_), out(metric_), out(brokenPairs_);
+    }
+    void loadState(StateReader& in) override {
+        in(pairAlive_), in(gradient_), in(restMetric_), in(metric_), in(brokenPairs_);
+    }
     /// Whether the pair i -> j (rest neighbours) is still whole; false when not neighbours.
     bool pairAlive(int i, int j) const;
 

@@ -68,7 +68,7 @@ bool StatsWriter::finish() {
 bool isRunOutputName(const std::string& name) {
     static const std::regex kNames(
         R"(stats\.csv|frames/frame_[0-9]{4,9}\.(png|exr)|meshes/frame_[0-9]{4,9}\.(ply|obj|mtl|glb)|)"
-        R"(vdb/frame_[0-9]{4,9}\.vdb)");
+        R"(vdb/frame_[0-9]{4,9}\.vdb|cache/frame_[0-9]{4,9}\.rcache|cache/source\.toml)");
     return std::regex_match(name, kNames);
 }
 

@@ -28,6 +28,10 @@ public:
         std::size_t brokenBonds;
     };
     void append(const Row& row);
+    /// Rows carried over as text (a resumed run's earlier frames), each ending in a newline.
+    void appendRows(const std::string& rows) {
+        if (!rows.empty()) write(rows);
+    }
     /// Renames stats.csv into place; false when a failed write already removed it.
     bool finish();
 

@@ -1,15 +1,18 @@
 #include "app/Pipeline.h"
 
 #include <omp.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
 
+#include "app/Cache.h"
 #include "app/FrameWriter.h"
 #include "app/Outputs.h"
 #include "app/SceneError.h"
@@ -184,11 +187,16 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"contact_list_builds\": " << s.contactListBuilds << ",\n"
       << "  \"frames_simulated\": " << s.framesSimulated << ",\n"
       << "  \"frames_written\": " << s.framesWritten << ",\n"
+      << "  \"resumed_after_frame\": " << s.resumedAfter << ",\n"
+      << "  \"cache\": {\"frames\": " << s.framesCached << ", \"bytes\": " << s.cacheBytes
+      << ", \"bytes_per_particle_frame\": "
+      << (s.framesCached > 0 ? double(s.cacheBytes) / s.framesCached / s.particles : 0.0) << "},\n"
       << "  \"threads\": " << omp_get_max_threads() << ",\n"
       << "  \"wall_seconds\": {\"setup\": " << s.seconds.setup
       << ", \"simulate\": " << s.seconds.simulate << ", \"contact\": " << s.seconds.contact
       << ", \"contact_lists\": " << s.seconds.contactLists << ", \"surface\": " << s.seconds.surface
-      << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write << "},\n"
+      << ", \"render\": " << s.seconds.render << ", \"write\": " << s.seconds.write
+      << ", \"cache\": " << s.seconds.cache << "},\n"
       << "  \"ns_per_particle_step\": " << s.nsPerParticleStep << ",\n"
       << "  \"state_hash\": " << jsonString(hash) << ",\n"
       << "  \"files\": " << jsonStringArray(files, "  ") << ",\n"
@@ -198,15 +206,30 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
     return j.str();
 }
 
-// The files a run writes: each written frame's and stats.csv when asked for (run.json is the
-// list itself).
-std::vector<std::string> plannedFiles(const FrameWriter& writer, int first, int last,
-                                      bool withStats) {
+// The files a run writes: each written frame's, the cache's and stats.csv when asked for
+// (run.json is the list itself).
+std::vector<std::string> plannedFiles(const FrameWriter& writer, std::span<const int> frames,
+                                      int last, int cacheEvery, bool withStats) {
     std::vector<std::string> names;
     if (withStats) names.push_back("stats.csv");
-    for (int frame = first; frame <= last; ++frame)
+    for (const int frame : frames)
         for (std::string& name : writer.plannedFiles(frame)) names.push_back(std::move(name));
+    if (cacheEvery > 0) names.push_back(kCacheSourceName);
+    for (int frame = cacheEvery; cacheEvery > 0 && frame <= last; frame += cacheEvery)
+        names.push_back(cacheFileName(frame));
     return names;
+}
+
+// What rend render rebuilds the scene from: its file and the --set values of the run.
+void writeCacheSource(const Scene& scene, const std::filesystem::path& outDir) {
+    toml::array overrides;
+    for (const std::string& set : scene.overrides) overrides.push_back(set);
+    const toml::table source{{"scene", std::filesystem::absolute(scene.file).string()},
+                             {"overrides", overrides}};
+    std::ostringstream text;
+    text << "# Written by rend run: rend render rebuilds the scene from this.\n" << source << "\n";
+    std::filesystem::create_directories(outDir / "cache");
+    render::writeFileAtomic(outDir / kCacheSourceName, text.str());
 }
 
 void reportRemoved(const std::vector<std::string>& removed, const std::filesystem::path& dir) {
@@ -308,19 +331,66 @@ std::pair<int, double> substepsPerFrame(double dt, double fps) {
     return {substeps, interval / substeps};
 }
 
-std::pair<int, int> parseFrameRange(const std::string& text, int frameCount) {
-    int first = 0, last = 0;
-    char extra = 0;
-    const bool single = std::sscanf(text.c_str(), "%d%c", &first, &extra) == 1;
-    const bool range = std::sscanf(text.c_str(), "%d-%d%c", &first, &last, &extra) == 2;
-    if (single) last = first;
-    if ((!single && !range) || first < 1 || last < first || last > frameCount)
-        throw SceneError("--frames " + text + ": error: expected N or FIRST-LAST within 1-" +
-                         std::to_string(frameCount) + " (the scene has " +
-                         std::to_string(frameCount) + " frames). Use e.g. --frames 1-" +
-                         std::to_string(frameCount) + ".");
-    return {first, last};
+std::uintmax_t cacheFrameBytes(const sim::Membrane& membrane) {
+    return membrane.saveState().size();
 }
+
+namespace {
+
+/// Loads the last complete cached frame of outDir into `membrane`; returns its frame. Throws
+/// SceneError when there is none for this scene.
+int resumeFromCache(const Scene& scene, const std::filesystem::path& outDir, int last,
+                    sim::Membrane& membrane) {
+    const std::uint64_t particles = std::uint64_t(membrane.particleCount());
+    const std::optional<int> frame =
+        lastCompleteCacheFrame(outDir, last, scene.simulationFingerprint, particles);
+    if (!frame)
+        throw SceneError("--resume: error: " + outDir.string() +
+                         " holds no complete cached frame of this scene (cache/frame_N.rcache "
+                         "written by rend run with the same scene and --set values). Run "
+                         "without --resume.");
+    const CacheFrame cached =
+        readCacheFrameFor(outDir, *frame, scene.simulationFingerprint, particles);
+    try {
+        membrane.loadState(cached.state);
+    } catch (const sim::StateMismatch& e) {
+        throw CacheError((outDir / cacheFileName(*frame)).string() + ": error: " + e.what() +
+                         ". Rerun without --resume.");
+    }
+    return *frame;
+}
+
+/// The stats rows of frames 1..upTo a killed or finished run left (stats.csv.partial, else
+/// stats.csv), as text.
+std::string statsRowsUpTo(const std::filesystem::path& outDir, int upTo) {
+    std::ifstream in(outDir / "stats.csv.partial");
+    if (!in) in.open(outDir / "stats.csv");
+    std::string line, rows;
+    std::getline(in, line);  // the header
+    while (std::getline(in, line)) {
+        int frame = 0;
+        if (std::sscanf(line.c_str(), "%d,", &frame) == 1 && frame >= 1 && frame <= upTo)
+            rows += line + "\n";
+    }
+    return rows;
+}
+
+/// The files of frames 1..upTo that the run being resumed completed.
+std::vector<std::string> filesUpTo(const std::filesystem::path& outDir,
+                                   const std::vector<std::string>& planned, int upTo) {
+    std::vector<std::string> done;
+    for (const std::string& name : planned) {
+        int frame = 0;
+        const std::size_t at = name.find("frame_");
+        if (at == std::string::npos || std::sscanf(name.c_str() + at, "frame_%d", &frame) != 1 ||
+            frame > upTo || !std::filesystem::exists(outDir / name))
+            continue;
+        done.push_back(name);
+    }
+    return done;
+}
+
+}  // namespace
 
 RunSummary runScene(const Scene& scene, const RunOptions& options) {
     RunSummary s;
@@ -338,12 +408,28 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.stableDt = membrane.stableTimeStep();
     s.substeps = adaptive ? 0 : substeps;
     std::fprintf(stderr, "estimate: %s\n", describeEstimate(estimateRun(scene, membrane)).c_str());
-    const int frames = scene.frameCount();
-    const auto [first, last] = options.frames.value_or(std::pair{1, frames});
+    std::vector<int> selected = options.frames;
+    if (selected.empty())
+        for (int frame = 1; frame <= scene.frameCount(); ++frame) selected.push_back(frame);
+    const int last = selected.back();
+    const auto isSelected = [&](int frame) {
+        return std::binary_search(selected.begin(), selected.end(), frame);
+    };
 
     std::filesystem::create_directories(options.outDir);
+    int resumedAfter = 0;
+    std::string carriedStats;
+    if (options.resume) {
+        resumedAfter = resumeFromCache(scene, options.outDir, last, membrane);
+        carriedStats = statsRowsUpTo(options.outDir, resumedAfter);
+        s.resumedAfter = resumedAfter;
+        std::fprintf(stderr, "resuming after frame %d (t = %.6g s, step %ld)\n", resumedAfter,
+                     membrane.time(), membrane.stepCount());
+    }
     FrameWriter writer(scene, options.outDir);
-    RunFolder folder(options.outDir, plannedFiles(writer, first, last, scene.writeStats));
+    const std::vector<std::string> planned =
+        plannedFiles(writer, selected, last, options.cacheEvery, scene.writeStats);
+    RunFolder folder(options.outDir, planned);
     auto writeRunJson = [&](const std::string& status, const std::vector<std::string>& files) {
         render::writeFileAtomic(options.outDir / "run.json",
                                 runJson(scene, s, status, stateHash(membrane), files));
@@ -351,8 +437,16 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     // Before anything else is written, so a killed run never leaves a folder that looks done.
     writeRunJson("running", folder.listedWhileRunning());
     reportRemoved(folder.removeStale(), options.outDir);
+    folder.wrote(filesUpTo(options.outDir, planned, resumedAfter));
+    if (options.cacheEvery > 0) {
+        writeCacheSource(scene, options.outDir);
+        folder.wrote({kCacheSourceName});
+    }
     std::optional<StatsWriter> stats;
-    if (scene.writeStats) stats.emplace(options.outDir / "stats.csv");
+    if (scene.writeStats) {
+        stats.emplace(options.outDir / "stats.csv");
+        stats->appendRows(carriedStats);
+    }
     Progress progress(options.progressBar, last);
     s.seconds.setup = secondsSince(t0);
 
@@ -390,9 +484,20 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         } catch (const std::exception&) {
         }
     };
+    // After the frame's pictures, so a cached frame's files are all complete (--resume).
+    auto cacheFrame = [&](int frame) {
+        if (options.cacheEvery <= 0 || frame % options.cacheEvery != 0) return;
+        const auto started = Clock::now();
+        s.cacheBytes += writeCacheFrame(
+            options.outDir, {frame, membrane.time(), scene.simulationFingerprint,
+                             std::uint64_t(membrane.particleCount()), membrane.saveState()});
+        folder.wrote({cacheFileName(frame)});
+        ++s.framesCached;
+        s.seconds.cache += secondsSince(started);
+    };
     std::vector<std::string> frameFiles;  // the current frame's, as they are completed
     try {
-        for (int frame = 1; frame <= last; ++frame) {
+        for (int frame = resumedAfter + 1; frame <= last; ++frame) {
             t0 = Clock::now();
             membrane.startFrame();  // a frame's lists are its own: checkpoints resume exactly
             if (adaptive)
@@ -404,14 +509,16 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             const StatsWriter::Row row = frameStats(frame, membrane);  // checks it is finite
             if (stats) stats->append(row);
             frameFiles.clear();
-            if (frame >= first && writer.active()) {
+            if (isSelected(frame) && writer.active()) {
                 membrane.updateDamage();
                 writer.write(membrane.view(frame), s.seconds, frameFiles);
                 folder.wrote(frameFiles);
                 ++s.framesWritten;
             }
+            cacheFrame(frame);
             progress.frameDone(frame, membrane.time(), frameFiles.empty() ? "" : frameFiles[0]);
         }
+        s.framesSimulated = std::max(s.framesSimulated, resumedAfter);
         finish("ok");
     } catch (const sim::NumericalBlowUp& e) {
         finish("blow-up");
@@ -424,6 +531,103 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         throw;
     }
     return s;
+}
+
+std::pair<std::filesystem::path, std::vector<std::string>> cacheSource(
+    const std::filesystem::path& outDir) {
+    const std::filesystem::path file = outDir / kCacheSourceName;
+    if (!std::filesystem::exists(file))
+        throw SceneError(outDir.string() +
+                         ": error: expected the folder of a rend run with its "
+                         "cache, found no " +
+                         std::string(kCacheSourceName) + ". Run rend run SCENE --out " +
+                         outDir.string() + " first.");
+    toml::table source;
+    try {
+        source = toml::parse_file(file.string());
+    } catch (const toml::parse_error& e) {
+        throw CacheError(file.string() + ": error: " + std::string(e.description()) +
+                         ". Rerun rend run into this folder.");
+    }
+    const std::optional<std::string> scene = source["scene"].value<std::string>();
+    const toml::array* overrides = source["overrides"].as_array();
+    if (!scene || !overrides)
+        throw CacheError(file.string() +
+                         ": error: expected scene and overrides. Rerun rend run "
+                         "into this folder.");
+    std::vector<std::string> sets;
+    for (const toml::node& set : *overrides)
+        if (const auto text = set.value<std::string>()) sets.push_back(*text);
+    return {*scene, sets};
+}
+
+namespace {
+
+/// The frames outDir's cache holds, ascending.
+std::vector<int> cachedFrames(const std::filesystem::path& outDir) {
+    std::vector<int> frames;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(outDir / "cache", ec)) {
+        int frame = 0;
+        char extra = 0;
+        const std::string name = entry.path().filename().string();
+        if (std::sscanf(name.c_str(), "frame_%d.rcach%c", &frame, &extra) == 2 && extra == 'e' &&
+            name == std::filesystem::path(cacheFileName(frame)).filename().string())
+            frames.push_back(frame);
+    }
+    std::sort(frames.begin(), frames.end());
+    return frames;
+}
+
+bool allExist(const std::filesystem::path& outDir, const std::vector<std::string>& names) {
+    return std::all_of(names.begin(), names.end(), [&](const std::string& name) {
+        return std::filesystem::exists(outDir / name);
+    });
+}
+
+}  // namespace
+
+RenderSummary renderFromCache(const Scene& scene, const RenderOptions& options) {
+    RenderSummary r;
+    auto t0 = Clock::now();
+    sim::Membrane membrane = prepareMembrane(scene);
+    FrameWriter writer(scene, options.outDir);
+    if (!writer.active())
+        throw SceneError(
+            "rend render: error: nothing to write: the renderer is none and no "
+            "export is asked for. Use e.g. --renderer osmesa or --export ply.");
+    const std::vector<int> frames =
+        options.frames.empty() ? cachedFrames(options.outDir) : options.frames;
+    if (frames.empty())
+        throw SceneError(options.outDir.string() + ": error: expected cached frames in " +
+                         (options.outDir / "cache").string() +
+                         ", found none. Run rend run with --cache-every 1 first.");
+    const std::uint64_t particles = std::uint64_t(membrane.particleCount());
+    Progress progress(options.progressBar, frames.back());
+    r.seconds.setup = secondsSince(t0);
+    std::vector<std::string> files;
+    for (const int frame : frames) {
+        if (options.skipExisting && allExist(options.outDir, writer.plannedFiles(frame))) {
+            ++r.framesSkipped;
+            continue;
+        }
+        t0 = Clock::now();
+        const CacheFrame cached =
+            readCacheFrameFor(options.outDir, frame, scene.simulationFingerprint, particles);
+        try {
+            membrane.loadState(cached.state);
+        } catch (const sim::StateMismatch& e) {
+            throw CacheError((options.outDir / cacheFileName(frame)).string() +
+                             ": error: " + e.what() + ". Rerun rend run into this folder.");
+        }
+        membrane.updateDamage();
+        r.seconds.simulate += secondsSince(t0);
+        files.clear();
+        writer.write(membrane.view(frame), r.seconds, files);
+        ++r.framesWritten;
+        progress.frameDone(frame, membrane.time(), files.empty() ? "" : files[0]);
+    }
+    return r;
 }
 
 }  // namespace rend

@@ -15,8 +15,12 @@ namespace rend {
 
 struct RunOptions {
     std::filesystem::path outDir = "out";
-    std::optional<std::pair<int, int>> frames;  ///< inclusive range of frames to write
-    bool progressBar = false;                   ///< redraw one line; else one line per frame
+    std::vector<int> frames;   ///< the frames to write, ascending; empty: all
+    bool progressBar = false;  ///< redraw one line; else one line per frame
+    /// Cache every N-th frame's state (cache/frame_N.rcache, app/Cache.h); 0: none.
+    int cacheEvery = 1;
+    /// Continue from the last complete cached frame in outDir (rend run --resume).
+    bool resume = false;
 };
 
 /// Wall seconds per stage of a run.
@@ -28,6 +32,7 @@ struct StageTimes {
     double surface = 0.0;
     double render = 0.0;
     double write = 0.0;
+    double cache = 0.0;  ///< writing the cache's frames
 };
 
 struct RunSummary {
@@ -46,6 +51,9 @@ struct RunSummary {
     long contactListBuilds = 0;  ///< the self-contact's candidate-list builds
     int framesSimulated = 0;
     int framesWritten = 0;
+    int resumedAfter = 0;           ///< the cached frame a --resume continued from; 0: none
+    int framesCached = 0;           ///< cache files this run wrote
+    std::uintmax_t cacheBytes = 0;  ///< their bytes
     StageTimes seconds;
     double nsPerParticleStep = 0.0;
 };
@@ -80,7 +88,30 @@ std::pair<int, double> substepsPerFrame(double dt, double fps);
 /// sim::NumericalBlowUp after finishing stats.csv and run.json up to the failing frame.
 RunSummary runScene(const Scene& scene, const RunOptions& options);
 
-/// Parses "7" or "1-120" against the scene's frame count. Throws SceneError.
-std::pair<int, int> parseFrameRange(const std::string& text, int frameCount);
+struct RenderOptions {
+    std::filesystem::path outDir = "out";  ///< a rend run's folder, with its cache
+    std::vector<int> frames;               ///< ascending; empty: every cached frame
+    bool skipExisting = false;  ///< leave frames whose every file is there (a farm's retry)
+    bool progressBar = false;
+};
+
+struct RenderSummary {
+    int framesWritten = 0, framesSkipped = 0;
+    StageTimes seconds;  ///< setup, cache reads (as simulate), surface, render, write
+};
+
+/// rend render: writes the frames and exports of `scene` from the cache in options.outDir,
+/// without simulating. Throws CacheError (a SceneError) naming a missing, damaged or foreign
+/// cache file; frames before it stay written.
+RenderSummary renderFromCache(const Scene& scene, const RenderOptions& options);
+
+/// The scene file and --set values a run's cache was written with (cache/source.toml); throws
+/// SceneError when the folder holds no cache.
+std::pair<std::filesystem::path, std::vector<std::string>> cacheSource(
+    const std::filesystem::path& outDir);
+
+/// The state bytes one cached frame holds before compression (the membrane at set-up; the
+/// same at every frame but for a fixed-step run's missing forces).
+std::uintmax_t cacheFrameBytes(const sim::Membrane& membrane);
 
 }  // namespace rend

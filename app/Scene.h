@@ -1,6 +1,7 @@
 #pragma once
 // A validated scene: everything `rend run` needs, with every value range-checked at load.
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -24,7 +25,8 @@ inline constexpr std::size_t kFinalParticles = 250000;
 enum class ExportFormat { Ply, Obj, Glb, Vdb };
 
 struct Scene {
-    std::filesystem::path file;  ///< the scene file as given
+    std::filesystem::path file;          ///< the scene file as given
+    std::vector<std::string> overrides;  ///< the --set values (and --quality) it was loaded with
     sim::MembraneParams sim;
     render::RenderSettings render;
     RendererKind renderer = RendererKind::Osmesa;
@@ -47,6 +49,9 @@ struct Scene {
 
     /// The resolved scene (preset merged, --set applied) as JSON, for run.json.
     std::string resolvedJson;
+    /// A hash of what the simulation depends on: the resolved scene without [render],
+    /// [camera], [light] and [output]. A cache is resumed or rendered only under the same one.
+    std::uint64_t simulationFingerprint = 0;
 
     int frameCount() const;  ///< round(duration * fps), at least 1
 

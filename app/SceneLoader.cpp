@@ -646,6 +646,15 @@ std::string toJson(const toml::table& document) {
     return out.str();
 }
 
+/// FNV-1a of the resolved scene's JSON without the tables that only shape the pictures.
+std::uint64_t simulationFingerprint(toml::table document) {
+    for (const char* pictureOnly : {"render", "camera", "light", "output"})
+        document.erase(pictureOnly);
+    std::uint64_t h = 0xcbf29ce484222325ULL;
+    for (const unsigned char c : toJson(document)) h = (h ^ c) * 0x100000001b3ULL;
+    return h;
+}
+
 /// Lattice points per dx^2: 2/sqrt(3) on the hexagonal lattice, 1 on the square one. The
 /// sphere's geodesic grid measured 2.04 (2562 particles for r = 1 m, dx = 0.1 m).
 double particlesPerCell(const sim::SheetParams& sheet) {
@@ -696,6 +705,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
                            file.string());
     Scene s;
     s.file = file;
+    s.overrides = overrides;
     readSheet(root, s);
     s.sim.material = readMaterial(root);
     s.sim.boundaries = readBoundaries(root, s);
@@ -712,6 +722,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     log.reportUnused();
     s.locations = log.locations();
     s.resolvedJson = toJson(document);
+    s.simulationFingerprint = simulationFingerprint(document);
     return s;
 }
 

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <string>
 
+#include "app/FrameSelection.h"
 #include "app/Pipeline.h"
 #include "app/Scene.h"
 #include "app/SceneError.h"
@@ -51,13 +52,17 @@ int checkCommand(const std::string& file, const std::vector<std::string>& sets,
         "%s: ok (quality %s, dx %.4g m)\n  %d particles, %zu bonds, dt %s%.4g s (stable limit "
         "%.4g s), %s%d steps per frame, %d frames\n"
         "  estimated memory %.3g GB (%.3g particles x (%g B + %.3g bonds x %g B))\n"
-        "  estimated cost: %s\n",
+        "  estimated cost: %s\n"
+        "  cache (rend run --cache-every 1): %.3g MB a frame before compression, at most %.3g GB "
+        "for %d frames\n",
         file.c_str(), std::string(rend::names::kQualities[std::size_t(scene.quality)]).c_str(),
         scene.sim.sheet.dx, membrane.particleCount(), membrane.bondCount(),
         adaptive ? "adaptive, at most " : "", dt, membrane.stableTimeStep(),
         adaptive ? "at least " : "", substeps, scene.frameCount(), sheet.bytes / 1e9,
         sheet.particles, rend::SheetEstimate::kBytesPerParticle, sheet.bondsPerParticle,
-        rend::SheetEstimate::kBytesPerBondEnd, rend::describeEstimate(estimate).c_str());
+        rend::SheetEstimate::kBytesPerBondEnd, rend::describeEstimate(estimate).c_str(),
+        double(rend::cacheFrameBytes(membrane)) / 1e6,
+        double(rend::cacheFrameBytes(membrane)) * scene.frameCount() / 1e9, scene.frameCount());
     return 0;
 }
 
@@ -74,10 +79,12 @@ std::vector<std::string> members(std::span<const std::string_view> names) {
 }
 
 struct RunArgs {
-    std::string scene, out = "out", frames, renderer, surface, exports, quality;
+    std::string scene, out = "out", frames, renderer, surface, exports, quality, chunk;
     std::vector<std::string> sets;
     int threads = 0;
     int spp = 0;
+    int cacheEvery = 1;
+    bool resume = false, skipExisting = false;
 };
 
 std::vector<rend::ExportFormat> parseExports(const std::string& text) {
@@ -119,14 +126,44 @@ int runCommand(const RunArgs& a) {
         throw rend::SceneError("--out " + a.out +
                                ": error: expected an output folder, found a file. Use another "
                                "--out, or move the file away.");
-    if (!a.frames.empty()) options.frames = rend::parseFrameRange(a.frames, scene.frameCount());
+    if (!a.frames.empty()) options.frames = rend::parseFrameList(a.frames, scene.frameCount());
     options.progressBar = isatty(STDERR_FILENO);
+    options.cacheEvery = a.cacheEvery;
+    options.resume = a.resume;
     const rend::RunSummary s = rend::runScene(scene, options);
     std::printf(
         "wrote %s: %d frames (%d images), %d particles, %zu bonds, %ld steps of %.4g s, "
         "%.1f ns per particle-step\n",
         a.out.c_str(), s.framesSimulated, s.framesWritten, s.particles, s.bonds, s.steps, s.dt,
         s.nsPerParticleStep);
+    return 0;
+}
+
+int renderCommand(const RunArgs& a) {
+    if (a.threads > 0) omp_set_num_threads(a.threads);
+    auto [file, sets] = rend::cacheSource(a.out);
+    sets.insert(sets.end(), a.sets.begin(), a.sets.end());  // the look may change; not the sim
+    rend::Scene scene = rend::loadScene(file, sets);
+    applyOverrides(a, scene);
+    rend::RenderOptions options;
+    options.outDir = a.out;
+    if (!a.frames.empty()) options.frames = rend::parseFrameList(a.frames, scene.frameCount());
+    if (!a.chunk.empty()) {
+        if (options.frames.empty())
+            for (int frame = 1; frame <= scene.frameCount(); ++frame)
+                options.frames.push_back(frame);
+        options.frames = rend::chunkOf(options.frames, a.chunk);
+        if (options.frames.empty()) {
+            std::printf("rendered nothing from %s: chunk %s holds no frame\n", a.out.c_str(),
+                        a.chunk.c_str());
+            return 0;
+        }
+    }
+    options.skipExisting = a.skipExisting;
+    options.progressBar = isatty(STDERR_FILENO);
+    const rend::RenderSummary r = rend::renderFromCache(scene, options);
+    std::printf("rendered %d frames from the cache in %s (%d skipped, already there)\n",
+                r.framesWritten, a.out.c_str(), r.framesSkipped);
     return 0;
 }
 
@@ -182,7 +219,9 @@ int main(int argc, char** argv) {
     runCmd->add_option("--out", run.out, "Output folder")
         ->capture_default_str()
         ->check(nonEmpty("an output folder", "--out out/stretch"));
-    runCmd->add_option("--frames", run.frames, "Frames to write: N or FIRST-LAST")
+    const std::string framesHelp =
+        "Frames to write: N, FIRST-LAST, FIRST-LAST:STEP, or a comma list";
+    runCmd->add_option("--frames", run.frames, framesHelp)
         ->check(nonEmpty("N or FIRST-LAST", "--frames 1-10 (or leave --frames out for all)"));
     runCmd->add_option("--renderer", run.renderer, "Override [render] renderer")
         ->check(CLI::IsMember(members(rend::names::kRenderers)));
@@ -196,7 +235,41 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1024));
     runCmd->add_option("--quality", run.quality, qualityHelp)->check(quality);
     runCmd->add_option("--set", run.sets, "Override a scene value: key.path=value (repeatable)");
+    runCmd
+        ->add_option("--cache-every", run.cacheEvery,
+                     "Cache every N-th frame's state in OUT/cache (0: no cache)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1000000));
+    runCmd->add_flag("--resume", run.resume,
+                     "Continue from the last complete cached frame in --out (after a kill)");
     runCmd->footer(solverHelp());
+
+    RunArgs render;
+    CLI::App* renderCmd = app.add_subcommand(
+        "render", "Render and export frames from a run's cache, without simulating");
+    renderCmd->add_option("out", render.out, "The output folder of a rend run, with its cache")
+        ->required()
+        ->check(nonEmpty("an output folder", "out/stretch"));
+    renderCmd->add_option("--frames", render.frames, framesHelp + " (default: every cached one)")
+        ->check(nonEmpty("a frame list", "--frames 1-10,20,30-40:2"));
+    renderCmd
+        ->add_option("--chunk", render.chunk,
+                     "K/N: the K-th of N contiguous chunks of the frames (a job array)")
+        ->check(nonEmpty("K/N", "--chunk 1/4"));
+    renderCmd->add_flag("--skip-existing", render.skipExisting,
+                        "Leave frames whose every file is already there");
+    renderCmd->add_option("--renderer", render.renderer, "Override [render] renderer")
+        ->check(CLI::IsMember(members(rend::names::kRenderers)));
+    renderCmd->add_option("--surface", render.surface, "Override [render] surface")
+        ->check(CLI::IsMember(members(rend::names::kSurfaces)));
+    renderCmd->add_option("--export", render.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
+        ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
+    renderCmd->add_option("--spp", render.spp, "Path-traced samples per pixel (embree)")
+        ->check(CLI::Range(1, 4096));
+    renderCmd->add_option("--threads", render.threads, "OpenMP threads (default: all cores)")
+        ->check(CLI::Range(1, 1024));
+    renderCmd->add_option("--set", render.sets,
+                          "Override a [render], [camera], [light] or [output] value");
 
     std::string checkScene, checkQuality;
     std::vector<std::string> checkSets;
@@ -216,6 +289,7 @@ int main(int argc, char** argv) {
     try {
         if (version) return printVersions(), 0;
         if (*runCmd) return runCommand(run);
+        if (*renderCmd) return renderCommand(render);
         if (*checkCmd) return checkCommand(checkScene, checkSets, checkQuality);
         std::cout << app.help();
         return 2;

@@ -8,6 +8,7 @@ packages=(
     libeigen3-dev libembree-dev libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev
     zlib1g-dev libopenexr-dev  # OpenEXR 3.1: frames for compositing (render/ExrWriter)
     libosmesa6-dev libstb-dev libassimp-dev libtomlplusplus-dev libcli11-dev
+    libzstd-dev  # the simulation cache (app/Cache): compressed, checksummed frames
     libgtest-dev libbenchmark-dev
     clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer with ASan and UBSan over the loader
 )

@@ -10,7 +10,9 @@ template <class Self, class Archive>
 void Membrane::visitState(Self& m, Archive& a) {
     expectSize(a, m.x0_.size(), "particles");
     expectSize(a, m.bonds_.directedCount(), "directed bonds");
-    a(m.x_), a(m.v_), a(m.force_), a(m.forcesCurrent_), a(m.theta_), a(m.damage_);
+    a(m.x_), a(m.v_), a(m.forcesCurrent_), a(m.theta_), a(m.damage_);
+    // Symplectic Euler recomputes the forces at a step's start; Verlet reuses the last step's.
+    if (m.forcesCurrent_) a(m.force_);
     a(m.time_), a(m.steps_), a(m.dt_), a(m.stiffening_), a(m.subSteps_), a(m.lastDrift_);
     a(m.dtMin_), a(m.dtMax_);
     TimeStepController::visitState(m.controller_, a);

@@ -214,7 +214,7 @@ check "full disk run.json says failed" test "$(json_status "$tmp/full/run.json")
 check "full disk at an OBJ exits 1" full_disk 40 scenes/stretch.toml "${small[@]}" --out "$tmp/fullobj" --export ply,obj
 check "full disk names the OBJ" grep -q "cannot write $tmp/fullobj/meshes/frame_0001.obj: File too large" "$tmp/stderr"
 check "full disk leaves no OBJ nor its MTL" test ! -e "$tmp/fullobj/meshes/frame_0001.obj" -a ! -e "$tmp/fullobj/meshes/frame_0001.mtl"
-check "full disk lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['frames/frame_0001.png','meshes/frame_0001.ply','stats.csv'], f" "$tmp/fullobj/run.json"
+check "full disk lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['cache/source.toml','frames/frame_0001.png','meshes/frame_0001.ply','stats.csv'], f" "$tmp/fullobj/run.json"
 check "full disk keeps the frames before the failure whole" pngs_complete "$tmp/fullobj"
 check "full disk at run.json exits 1" full_disk 1 scenes/stretch.toml "${small[@]}" --out "$tmp/fulljson"
 check "full disk at run.json writes nothing" test -z "$(find "$tmp/fulljson" -type f)"
@@ -223,14 +223,15 @@ check "full disk at a VDB exits 1" full_disk 100 scenes/stretch.toml "${small[@]
 check "full disk at a VDB names it" grep -q "cannot write $tmp/fullvdb/vdb/frame_0001.vdb: File too large" "$tmp/stderr"
 check "full disk leaves no VDB" test -z "$(find "$tmp/fullvdb" -name '*.vdb*')"
 
-# A rerun replaces the previous run's files: 12 frames, then 6, leaves 6 and says so.
+# A rerun replaces the previous run's files: 12 frames, then 6, leaves 6 and says so (each
+# frame's PNG, PLY and cache file: the second run removes 6 PNGs, 12 PLYs and 6 cache files).
 rerun=(scenes/stretch.toml --set 'sheet.size=[0.4,0.4]' --set time.duration=0.5 --set render.width=32 --set render.height=32 --out "$tmp/rerun")
 check "first run of 12 frames" run 0 run "${rerun[@]}" --export ply
 check "rerun of 6 frames" run 0 run "${rerun[@]}" --frames 1-6
-check "rerun says what it removed" grep -q "removed 18 files of the previous run in $tmp/rerun that this run does not write" "$tmp/stderr"
+check "rerun says what it removed" grep -q "removed 24 files of the previous run in $tmp/rerun that this run does not write" "$tmp/stderr"
 check "rerun leaves exactly 6 PNGs" test "$(ls "$tmp/rerun/frames" | tr '\n' ' ')" = "frame_0001.png frame_0002.png frame_0003.png frame_0004.png frame_0005.png frame_0006.png "
 check "rerun removes the stale meshes and their folder" test ! -e "$tmp/rerun/meshes"
-check "rerun run.json says 6" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['frames_written']==6 and d['status']=='ok' and len(d['files'])==7, d['files']" "$tmp/rerun/run.json"
+check "rerun run.json says 6" python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['frames_written']==6 and d['status']=='ok' and len(d['files'])==14, d['files']" "$tmp/rerun/run.json"
 touch "$tmp/rerun/frames/notes.txt" "$tmp/rerun/frames/frame_0009.png"
 check "rerun of frames 3-4" run 0 run "${rerun[@]}" --frames 3-4
 check "a --frames rerun keeps only its own frames and files rend never wrote" test "$(ls "$tmp/rerun/frames" | tr '\n' ' ')" = "frame_0003.png frame_0004.png frame_0009.png notes.txt "
@@ -297,6 +298,61 @@ check "final_frames renders the last frame" cmp -s "$tmp/final/seaweed.png" \
 check "final_frames writes no other frame" test ! -e "$tmp/final/seaweed/frames/frame_0011.png"
 check "final_frames reports the run" \
     grep -qE "^seaweed: 2929 particles, [0-9]+ steps, [1-9][0-9]* broken bonds" "$tmp/final.txt"
+
+# The simulation cache: a run killed with SIGKILL resumes from its last whole cached frame and
+# ends with the bits of a run that never stopped; rend render redraws frames from the cache, in
+# chunks as a job array would, and refuses a damaged cache file by name.
+cached=(scenes/towel_pile.toml --set render.width=48 --set render.height=27 --threads 1)
+check "uninterrupted run" run 0 run "${cached[@]}" --out "$tmp/straight"
+"$rend" run "${cached[@]}" --out "$tmp/killed" >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 200); do [[ -e "$tmp/killed/cache/frame_0012.rcache" ]] && break; sleep 0.05; done
+kill -9 $pid 2>/dev/null
+wait $pid 2>/dev/null
+check "killed before the end" test ! -e "$tmp/killed/stats.csv"
+check "resume" run 0 run "${cached[@]}" --out "$tmp/killed" --resume
+check "resume says where it continues" grep -q "^resuming after frame [0-9]" "$tmp/stderr"
+state_hash() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['state_hash'])" "$1/run.json"; }
+check "resumed state hash is the uninterrupted one" test "$(state_hash "$tmp/killed")" = "$(state_hash "$tmp/straight")"
+check "resumed stats are the uninterrupted ones" cmp -s "$tmp/killed/stats.csv" "$tmp/straight/stats.csv"
+check "resumed frames are the uninterrupted ones" diff -r -q "$tmp/killed/frames" "$tmp/straight/frames"
+check "resumed run lists every frame and cache file" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert sum(n.startswith('frames/') for n in f)==48 and sum(n.endswith('.rcache') for n in f)==48, f" "$tmp/killed/run.json"
+check "resume leaves no temporary file" no_partial_files "$tmp/killed"
+check "resume of another scene's cache refused" run 2 run scenes/towel_pile.toml --set material.E=4e5 --out "$tmp/killed" --resume
+check "resume of another scene names the fix" grep -q "no complete cached frame of this scene" "$tmp/stderr"
+check "resume with no cache refused" run 2 run scenes/stretch.toml --out "$tmp/nocache" --resume
+check "--cache-every 0 writes no cache" run 0 run scenes/stretch.toml --set time.duration=0.25 --renderer none --cache-every 0 --out "$tmp/nocache"
+check "--cache-every 0 leaves no cache folder" test ! -e "$tmp/nocache/cache"
+check "--cache-every 4 caches every fourth frame" run 0 run scenes/stretch.toml --set time.duration=0.5 --renderer none --cache-every 4 --out "$tmp/every4"
+check "every fourth frame cached" test "$(ls "$tmp/every4/cache" | tr '\n' ' ')" = "frame_0004.rcache frame_0008.rcache frame_0012.rcache source.toml "
+check "check prints the cache estimate" run 0 check scenes/towel_pile.toml
+check "cache estimate line" grep -qE "cache \(rend run --cache-every 1\): [0-9.]+ MB a frame" "$tmp/stdout"
+
+mkdir -p "$tmp/farm"
+cp -r "$tmp/straight/cache" "$tmp/farm/"
+for k in 1 2 3; do
+    check "render chunk $k/3" run 0 render "$tmp/farm" --chunk $k/3 --threads 1
+done
+check "three chunks are the whole run's frames" diff -r -q "$tmp/farm/frames" "$tmp/straight/frames"
+check "render a farm frame list" run 0 render "$tmp/farm" --frames 1-10,20,30-40:2 --skip-existing
+check "skip-existing skips what is there" grep -q "rendered 0 frames .*(17 skipped" "$tmp/stdout"
+rm "$tmp/farm/frames/frame_0020.png"
+check "skip-existing redraws what is missing" run 0 render "$tmp/farm" --frames 20 --skip-existing
+check "the redrawn frame is the run's" cmp -s "$tmp/farm/frames/frame_0020.png" "$tmp/straight/frames/frame_0020.png"
+check "render exports from the cache" run 0 render "$tmp/farm" --frames 48 --export ply --renderer none
+check "export written" test -s "$tmp/farm/meshes/frame_0048.ply"
+rm "$tmp/farm/frames/frame_0030.png"
+printf 'x' | dd of="$tmp/farm/cache/frame_0030.rcache" bs=1 seek=300 conv=notrunc 2>/dev/null
+check "damaged cache file refused" run 2 render "$tmp/farm" --frames 30
+check "damaged cache file named" grep -q "frame_0030.rcache: error: damaged" "$tmp/stderr"
+check "nothing rendered from a damaged file" test ! -e "$tmp/farm/frames/frame_0030.png"
+head -c 100 "$tmp/straight/cache/frame_0031.rcache" > "$tmp/farm/cache/frame_0031.rcache"
+check "truncated cache file refused" run 2 render "$tmp/farm" --frames 31
+check "truncated cache file named" grep -q "frame_0031.rcache: error: truncated" "$tmp/stderr"
+check "render of a sim change refused" run 2 render "$tmp/farm" --frames 5 --set material.E=4e5
+check "render of a sim change says so" grep -q "written for another scene" "$tmp/stderr"
+check "render of a folder without cache refused" run 2 render "$tmp/nocache"
+check "bad chunk refused" run 2 render "$tmp/farm" --chunk 4/3
 
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -30,7 +30,7 @@ TEST(ExrOutput, ThePathTracerWritesAnExrBesideEachPngAndListsIt) {
     fs::remove_all(dir);
     rend::RunOptions options;
     options.outDir = dir;
-    options.frames = std::pair{1, 1};
+    options.frames = {1};
     rend::runScene(tinyScene("embree"), options);
     const rend::render::ExrChannels exr = rend::render::readExr(dir / "frames/frame_0001.exr");
     EXPECT_EQ(exr.width, 48);

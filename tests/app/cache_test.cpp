@@ -1,0 +1,114 @@
+// Issue 14: the simulation cache's files read back whole, and anything else is refused by name.
+
+#include "app/Cache.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+namespace fs = std::filesystem;
+using namespace rend;
+
+namespace {
+
+fs::path freshDir(const char* name) {
+    const fs::path dir = fs::temp_directory_path() / name;
+    fs::remove_all(dir);
+    return dir;
+}
+
+/// A state with the texture of a real one: smooth doubles, runs of equal flags, and a tail
+/// shorter than a word.
+CacheFrame sampleFrame(int frame) {
+    CacheFrame f{frame, 0.25 * frame, 0x1234abcdULL, 1000, {}};
+    std::mt19937 random(7);
+    for (int i = 0; i < 1000; ++i) {
+        const double x = 0.001 * i + (random() % 2 ? 0.0 : 1e-6);
+        const auto* p = reinterpret_cast<const std::byte*>(&x);
+        f.state.insert(f.state.end(), p, p + sizeof x);
+    }
+    f.state.insert(f.state.end(), 3000, std::byte{1});
+    f.state.insert(f.state.end(), {std::byte{9}, std::byte{8}, std::byte{7}});
+    return f;
+}
+
+std::string slurp(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void overwrite(const fs::path& file, const std::string& bytes) {
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+/// The message of the CacheError that reading `file` throws; empty when none.
+std::string errorReading(const fs::path& dir, int frame) {
+    try {
+        readCacheFrameFor(dir, frame, 0x1234abcdULL, 1000);
+    } catch (const CacheError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+TEST(Cache, AFrameReadsBackBitForBitAndCompressed) {
+    const fs::path dir = freshDir("rend_cache_roundtrip");
+    const CacheFrame written = sampleFrame(7);
+    const std::uintmax_t bytes = writeCacheFrame(dir, written);
+    EXPECT_EQ(fs::file_size(dir / cacheFileName(7)), bytes);
+    EXPECT_LT(double(bytes), 0.6 * double(written.state.size())) << "the flags compress";
+    EXPECT_FALSE(fs::exists(dir / "cache/frame_0007.rcache.tmp")) << "renamed into place";
+    const CacheFrame read = readCacheFrameFor(dir, 7, 0x1234abcdULL, 1000);
+    EXPECT_EQ(read.frame, 7);
+    EXPECT_EQ(read.time, 1.75);
+    EXPECT_EQ(read.state, written.state);
+    EXPECT_EQ(cacheFileName(7), "cache/frame_0007.rcache");
+}
+
+TEST(Cache, DamagedTruncatedAndForeignFilesAreRefusedByName) {
+    const fs::path dir = freshDir("rend_cache_damage");
+    writeCacheFrame(dir, sampleFrame(3));
+    const fs::path file = dir / cacheFileName(3);
+    const std::string good = slurp(file);
+    const std::string name = file.string() + ": error: ";
+
+    std::string flipped = good;
+    flipped[good.size() / 2] = char(flipped[good.size() / 2] ^ 0x10);  // in the compressed state
+    overwrite(file, flipped);
+    EXPECT_NE(errorReading(dir, 3).find(name + "damaged"), std::string::npos)
+        << errorReading(dir, 3);
+
+    flipped = good;
+    flipped[20] = char(flipped[20] ^ 1);  // in the header (the time)
+    overwrite(file, flipped);
+    EXPECT_NE(errorReading(dir, 3).find(name + "damaged: its header"), std::string::npos);
+
+    for (const std::size_t length : {std::size_t(0), std::size_t(30), good.size() - 1}) {
+        overwrite(file, good.substr(0, length));
+        EXPECT_NE(errorReading(dir, 3).find(name + "truncated"), std::string::npos)
+            << length << ": " << errorReading(dir, 3);
+    }
+    overwrite(file, "not a cache at all, but long enough to hold a header of sixty-four bytes");
+    EXPECT_NE(errorReading(dir, 3).find("not a rend cache file"), std::string::npos);
+
+    overwrite(file, good);
+    EXPECT_EQ(errorReading(dir, 3), "");
+    EXPECT_THROW(readCacheFrameFor(dir, 3, 0x999ULL, 1000), CacheError) << "another scene";
+    EXPECT_THROW(readCacheFrameFor(dir, 3, 0x1234abcdULL, 999), CacheError) << "other particles";
+    EXPECT_NE(errorReading(dir, 4).find("frame 4 is not in the cache"), std::string::npos);
+}
+
+TEST(Cache, TheLastCompleteFrameSkipsAKilledRunsDamagedTail) {
+    const fs::path dir = freshDir("rend_cache_last");
+    for (int frame = 1; frame <= 4; ++frame) writeCacheFrame(dir, sampleFrame(frame));
+    const fs::path fourth = dir / cacheFileName(4);
+    overwrite(fourth, slurp(fourth).substr(0, 100));
+    EXPECT_EQ(lastCompleteCacheFrame(dir, 10, 0x1234abcdULL, 1000), 3);
+    EXPECT_EQ(lastCompleteCacheFrame(dir, 2, 0x1234abcdULL, 1000), 2) << "within the run's frames";
+    EXPECT_EQ(lastCompleteCacheFrame(dir, 10, 0x999ULL, 1000), std::nullopt) << "another scene's";
+}

@@ -19,7 +19,7 @@ StatsWriter::StatsWriter(const fs::path& path) : path_(path) {
     fs::path partial = path_;
     partial += ".partial";
     file_.emplace(partial);
-    write("frame,time,kinetic_energy,strain_energy,max_speed,max_theta,broken_bonds\n");
+    write("frame,time,kinetic_energy,strain_energy,max_speed,max_theta,broken_bonds,steps,dt\n");
 }
 
 StatsWriter::~StatsWriter() {
@@ -44,8 +44,9 @@ void StatsWriter::write(const std::string& text) {
 
 void StatsWriter::append(const Row& r) {
     char row[256];
-    std::snprintf(row, sizeof row, "%d,%.9g,%.9g,%.9g,%.9g,%.9g,%zu\n", r.frame, r.time,
-                  r.kineticEnergy, r.strainEnergy, r.maxSpeed, r.maxTheta, r.brokenBonds);
+    std::snprintf(row, sizeof row, "%d,%.9g,%.9g,%.9g,%.9g,%.9g,%zu,%ld,%.9g\n", r.frame, r.time,
+                  r.kineticEnergy, r.strainEnergy, r.maxSpeed, r.maxTheta, r.brokenBonds, r.steps,
+                  r.dt);
     write(row);
 }
 

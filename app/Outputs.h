@@ -26,6 +26,8 @@ public:
         int frame;
         double time, kineticEnergy, strainEnergy, maxSpeed, maxTheta;
         std::size_t brokenBonds;
+        long steps;  ///< explicit steps since t = 0
+        double dt;   ///< the frame's last step [s]
     };
     void append(const Row& row);
     /// Rows carried over as text (a resumed run's earlier frames), each ending in a newline.

@@ -247,8 +247,9 @@ void reportRemoved(const std::vector<std::string>& removed, const std::filesyste
 // The frame's stats row. A value that is not finite stops the run before the row or the frame
 // is written, naming the fastest particle (the guard's checks normally stop it earlier).
 StatsWriter::Row frameStats(int frame, const sim::Membrane& m) {
-    const StatsWriter::Row row{frame,        m.time(),     m.kineticEnergy(),  m.strainEnergy(),
-                               m.maxSpeed(), m.maxTheta(), m.brokenBondCount()};
+    const StatsWriter::Row row{frame,        m.time(),     m.kineticEnergy(),   m.strainEnergy(),
+                               m.maxSpeed(), m.maxTheta(), m.brokenBondCount(), m.stepCount(),
+                               m.timeStep()};
     const std::pair<const char*, double> values[] = {{"kinetic energy", row.kineticEnergy},
                                                      {"strain energy", row.strainEnergy},
                                                      {"largest speed", row.maxSpeed},

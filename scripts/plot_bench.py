@@ -19,7 +19,14 @@ def read_rows(path):
     cases = OrderedDict()
     with open(path, newline="") as f:
         lines = [line for line in f if line.strip() and not line.startswith("#")]
-    for row in csv.DictReader(lines):
+    reader = csv.DictReader(lines)
+    needed = {"case", "setting", "wall_seconds", "error"}
+    if not needed <= set(reader.fieldnames or []):
+        hint = (" It is a run's stats.csv: draw it with scripts/plot_run.py OUT_DIR."
+                if "kinetic_energy" in (reader.fieldnames or []) else "")
+        raise SystemExit(f"error: {path}: expected bench_accuracy's CSV with the columns "
+                         f"{', '.join(sorted(needed))}.{hint}")
+    for row in reader:
         family, _, label = row["setting"].rpartition("/")
         family = family or row["setting"]
         cases.setdefault(row["case"], OrderedDict()).setdefault(family, []).append(

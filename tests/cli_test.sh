@@ -354,5 +354,16 @@ check "render of a sim change says so" grep -q "written for another scene" "$tmp
 check "render of a folder without cache refused" run 2 render "$tmp/nocache"
 check "bad chunk refused" run 2 render "$tmp/farm" --chunk 4/3
 
+# scripts/plot_run.py draws a run's stats.csv; plot_bench.py refuses one with a pointer to it.
+mkdir -p "$tmp/empty"
+if /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+    check "plot_run draws the run" scripts/plot_run.py "$tmp/straight" --out "$tmp/stats.png"
+    check "plot_run writes a PNG" python3 -c "import sys; d=open(sys.argv[1],'rb').read(); assert d[:8]==b'\x89PNG\r\n\x1a\n' and len(d)>20000, len(d)" "$tmp/stats.png"
+else
+    echo "SKIPPED: plot_run.py (python3-matplotlib is not installed; scripts/setup.sh installs it)"
+fi
+check "plot_run refuses a folder without stats" bash -c '! scripts/plot_run.py "$1" 2>"$2" && grep -q "holds no stats.csv" "$2"' _ "$tmp/empty" "$tmp/plot_err"
+check "plot_bench refuses stats.csv by name" bash -c '! scripts/plot_bench.py "$1" 2>"$2" && grep -q "draw it with scripts/plot_run.py" "$2" && ! grep -q Traceback "$2"' _ "$tmp/straight/stats.csv" "$tmp/plot_err"
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

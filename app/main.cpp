@@ -190,6 +190,20 @@ CLI::Validator nonEmpty(const std::string& expected, const std::string& example)
         "");
 }
 
+/// The options rend run and rend render share: what is drawn and exported, and the threads.
+void addOutputOptions(CLI::App* command, RunArgs& a) {
+    command->add_option("--renderer", a.renderer, "Override [render] renderer")
+        ->check(CLI::IsMember(members(rend::names::kRenderers)));
+    command->add_option("--surface", a.surface, "Override [render] surface")
+        ->check(CLI::IsMember(members(rend::names::kSurfaces)));
+    command->add_option("--export", a.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
+        ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
+    command->add_option("--spp", a.spp, "Path-traced samples per pixel (embree)")
+        ->check(CLI::Range(1, 4096));
+    command->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")
+        ->check(CLI::Range(1, 1024));
+}
+
 // The solvers a scene can name, from the registry, for `rend --help` and `rend run --help`.
 std::string solverHelp() {
     std::string out = "Solvers (solver = \"NAME\" in a scene, or --set solver=NAME):\n";
@@ -223,16 +237,7 @@ int main(int argc, char** argv) {
         "Frames to write: N, FIRST-LAST, FIRST-LAST:STEP, or a comma list";
     runCmd->add_option("--frames", run.frames, framesHelp)
         ->check(nonEmpty("N or FIRST-LAST", "--frames 1-10 (or leave --frames out for all)"));
-    runCmd->add_option("--renderer", run.renderer, "Override [render] renderer")
-        ->check(CLI::IsMember(members(rend::names::kRenderers)));
-    runCmd->add_option("--surface", run.surface, "Override [render] surface")
-        ->check(CLI::IsMember(members(rend::names::kSurfaces)));
-    runCmd->add_option("--export", run.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
-        ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
-    runCmd->add_option("--spp", run.spp, "Path-traced samples per pixel (embree)")
-        ->check(CLI::Range(1, 4096));
-    runCmd->add_option("--threads", run.threads, "OpenMP threads (default: all cores)")
-        ->check(CLI::Range(1, 1024));
+    addOutputOptions(runCmd, run);
     runCmd->add_option("--quality", run.quality, qualityHelp)->check(quality);
     runCmd->add_option("--set", run.sets, "Override a scene value: key.path=value (repeatable)");
     runCmd
@@ -258,16 +263,7 @@ int main(int argc, char** argv) {
         ->check(nonEmpty("K/N", "--chunk 1/4"));
     renderCmd->add_flag("--skip-existing", render.skipExisting,
                         "Leave frames whose every file is already there");
-    renderCmd->add_option("--renderer", render.renderer, "Override [render] renderer")
-        ->check(CLI::IsMember(members(rend::names::kRenderers)));
-    renderCmd->add_option("--surface", render.surface, "Override [render] surface")
-        ->check(CLI::IsMember(members(rend::names::kSurfaces)));
-    renderCmd->add_option("--export", render.exports, "Per-frame exports, e.g. ply,obj,glb,vdb")
-        ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
-    renderCmd->add_option("--spp", render.spp, "Path-traced samples per pixel (embree)")
-        ->check(CLI::Range(1, 4096));
-    renderCmd->add_option("--threads", render.threads, "OpenMP threads (default: all cores)")
-        ->check(CLI::Range(1, 1024));
+    addOutputOptions(renderCmd, render);
     renderCmd->add_option("--set", render.sets,
                           "Override a [render], [camera], [light] or [output] value");
 

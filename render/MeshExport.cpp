@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "render/AtomicFile.h"
+#include "render/ObjExport.h"
 
 namespace rend::render {
 
@@ -30,7 +31,7 @@ const char* assimpFormatId(MeshFormat format) {
         case MeshFormat::Ply:
             return "plyb";  // unused: see writePly
         case MeshFormat::Obj:
-            return "obj";
+            return "obj";  // unused: see writeObj
         case MeshFormat::Glb:
             return "glb2";
     }
@@ -270,6 +271,7 @@ std::vector<fs::path> exportMesh(const Mesh& mesh, const fs::path& path, MeshFor
         writePly(mesh, path);
         return {path};
     }
+    if (format == MeshFormat::Obj) return writeObj(mesh, path);
     try {
         return writeWithAssimp(mesh, path, format);
     } catch (const std::system_error&) {

@@ -1,8 +1,9 @@
 #pragma once
 // Writes a render Mesh to a file another tool can open: binary PLY (point-cloud and geometry
-// tools), OBJ + MTL (everything), GLB (web viewers, Blender). OBJ and GLB go through assimp;
-// binary PLY is written directly because assimp 5.2's binary PLY exporter corrupts files that
-// have vertex colours (see MeshExport.cpp).
+// tools), OBJ + MTL (everything), GLB (web viewers, Blender). GLB goes through assimp; binary
+// PLY and OBJ are written directly, because assimp 5.2's binary PLY exporter corrupts files that
+// have vertex colours (see MeshExport.cpp) and its OBJ exporter joins coincident vertices
+// (render/ObjExport.h).
 
 #include <filesystem>
 #include <string_view>

@@ -6,15 +6,19 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -821,6 +825,96 @@ TEST(MeshExport, ObjReferencesItsMaterialLibraryByTheFinalName) {
     std::ifstream in(dir / "sheet.obj");
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("mtllib sheet.mtl"), std::string::npos);
+}
+
+namespace {
+
+/// Loose parts by shared vertex indices (as Blender counts them), over the vertices faces use.
+std::size_t looseParts(std::size_t vertices,
+                       const std::vector<std::array<std::uint32_t, 3>>& faces) {
+    std::vector<std::uint32_t> parent(vertices);
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto root = [&](std::uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    std::set<std::uint32_t> used;
+    for (const auto& f : faces) {
+        used.insert(f.begin(), f.end());
+        parent[root(f[0])] = root(f[1]);
+        parent[root(f[1])] = root(f[2]);
+    }
+    std::set<std::uint32_t> roots;
+    for (const std::uint32_t v : used) roots.insert(root(v));
+    return roots.size();
+}
+
+struct IndexedFile {
+    std::size_t vertices = 0;
+    std::vector<std::array<std::uint32_t, 3>> faces;
+};
+
+IndexedFile readObjIndices(const fs::path& path) {
+    IndexedFile out;
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) {
+        if (line.starts_with("v ")) ++out.vertices;
+        if (!line.starts_with("f ")) continue;
+        std::istringstream words(line.substr(2));
+        std::array<std::uint32_t, 3> face{};
+        for (std::uint32_t& v : face) {
+            std::string word;
+            words >> word;
+            v = std::uint32_t(std::stoul(word.substr(0, word.find('/')))) - 1;
+        }
+        out.faces.push_back(face);
+    }
+    return out;
+}
+
+IndexedFile readPlyIndices(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t body = text.find("end_header\n") + 11;
+    IndexedFile out;
+    std::size_t faces = 0, stride = 0;
+    std::istringstream header(text.substr(0, body));
+    for (std::string line; std::getline(header, line);) {
+        if (line.starts_with("element vertex ")) out.vertices = std::stoul(line.substr(15));
+        if (line.starts_with("element face ")) faces = std::stoul(line.substr(13));
+        if (line.starts_with("property float")) stride += 4;
+        if (line.starts_with("property uchar")) stride += 1;
+    }
+    std::size_t at = body + out.vertices * stride;
+    for (std::size_t f = 0; f < faces; ++f, at += 13) {
+        std::array<std::uint32_t, 3> face{};
+        std::memcpy(face.data(), text.data() + at + 1, sizeof face);
+        out.faces.push_back(face);
+    }
+    return out;
+}
+
+}  // namespace
+
+// Issue 14: a crack's two lips coincide until it opens, and a bow-tie's two fans share a
+// position, each with vertices of their own; assimp's OBJ exporter merged such vertices.
+TEST(MeshExport, PlyAndObjKeepEveryVertexAndTheSameLooseParts) {
+    Mesh mesh;
+    mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0},  // piece A
+                      {1, 0, 0}, {2, 0, 0}, {1, 1, 0},  // piece B: its vertex 3 lies on A's 1
+                      {5, 5, 5}};                       // a particle no triangle holds any more
+    mesh.normals.assign(mesh.positions.size(), Eigen::Vector3f(0, 0, 1));
+    mesh.colors.assign(mesh.positions.size(), Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+    mesh.triangles = {{0, 1, 2}, {3, 4, 5}};
+    ASSERT_EQ(looseParts(mesh.positions.size(), mesh.triangles), 2u);
+    const fs::path dir = scratchDir("export_parts");
+    rend::render::exportMesh(mesh, dir / "m.ply", MeshFormat::Ply);
+    rend::render::exportMesh(mesh, dir / "m.obj", MeshFormat::Obj);
+    for (const IndexedFile& file : {readPlyIndices(dir / "m.ply"), readObjIndices(dir / "m.obj")}) {
+        EXPECT_EQ(file.vertices, mesh.positions.size()) << "vertex i stays vertex i";
+        EXPECT_EQ(file.faces, mesh.triangles);
+        EXPECT_EQ(looseParts(file.vertices, file.faces), 2u);
+    }
 }
 
 TEST(MeshExport, ExportedSurfacesKeepTheirTriangleCount) {

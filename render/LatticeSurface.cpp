@@ -110,6 +110,7 @@ void addWalls(Mesh& mesh, std::uint32_t sheetVertices,
             mesh.colors.push_back(mesh.colors[v]);
             if (!mesh.layers.empty()) mesh.layers.push_back(mesh.layers[v]);
             if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
+            if (!mesh.points.empty()) mesh.points.push_back(mesh.points[v]);
         }
         return wall[v];
     };
@@ -136,6 +137,7 @@ void extrude(Mesh& mesh, double thickness) {
         mesh.colors.push_back(mesh.colors[v]);
         if (!mesh.layers.empty()) mesh.layers.push_back(mesh.layers[v]);
         if (!mesh.theta.empty()) mesh.theta.push_back(mesh.theta[v]);
+        if (!mesh.points.empty()) mesh.points.push_back(mesh.points[v]);
     }
     const std::size_t faces = mesh.triangles.size();
     for (std::size_t t = 0; t < faces; ++t) {
@@ -412,11 +414,14 @@ public:
         colours_ = particleColors(frame, settings);
         layers_ = particleLayers(frame, settings);
         theta_ = frame.theta;
+        velocities_ = frame.velocities;
+        damage_ = frame.damage;
         const std::size_t vertices = placed.size() + corners.copyOf.size() + 2 * cuts.edges.size();
         mesh.positions.reserve(vertices);
         mesh.colors.reserve(vertices);
         mesh.layers.reserve(layers_.empty() ? 0 : vertices);
         mesh.theta.reserve(theta_.empty() ? 0 : vertices);
+        mesh.points.reserve(vertices);
         for (int i = 0; i < static_cast<int>(placed.size()); ++i) add(x(i), attributes(i));
         for (int p : corners.copyOf) add(x(p), attributes(p));
         lipBase_ = static_cast<std::uint32_t>(mesh.positions.size());
@@ -424,8 +429,8 @@ public:
             const auto [i, j] = s_.edges_.ends[cuts.edges[k]];
             const double t = cuts.t[k];
             const Attributes crossing = attributes(i, j, float(t));
-            add(lipPosition(i, j, t), crossing);
-            add(lipPosition(j, i, 1.0 - t), crossing);
+            add(lipPosition(i, j, t), withPoint(crossing, i, crossing.point.rest));
+            add(lipPosition(j, i, 1.0 - t), withPoint(crossing, j, crossing.point.rest));
         }
         mesh.triangles.reserve(s_.triangles_.size() + 3 * cuts.edges.size());
     }
@@ -477,24 +482,51 @@ private:
         Eigen::Vector3f colour;
         Eigen::Vector2f layer = Eigen::Vector2f::Zero();
         float theta = 0.0f;
+        Mesh::Point point;
     };
+
+    Mesh::Point point(int i) const {
+        Mesh::Point p;
+        p.id = i;
+        if (!velocities_.empty()) p.velocity = velocities_[i].cast<float>();
+        p.damage = damage_.empty() ? 0.0f : float(damage_[i]);
+        p.rest = rest(i).cast<float>();
+        return p;
+    }
 
     Attributes attributes(int i) const {
         return {colours_[i], layers_.empty() ? Eigen::Vector2f::Zero() : layers_[i],
-                theta_.empty() ? 0.0f : float(theta_[i])};
+                theta_.empty() ? 0.0f : float(theta_[i]), point(i)};
     }
 
-    /// Interpolated at fraction t of the way from particle i to j.
+    /// Interpolated at fraction t of the way from particle i to j (the point data as i's but
+    /// for the rest position).
     Attributes attributes(int i, int j, float t) const {
         const Attributes a = attributes(i), b = attributes(j);
         return {(1.0f - t) * a.colour + t * b.colour, (1.0f - t) * a.layer + t * b.layer,
-                (1.0f - t) * a.theta + t * b.theta};
+                (1.0f - t) * a.theta + t * b.theta,
+                withRest(a.point, (1.0f - t) * a.point.rest + t * b.point.rest)};
     }
 
     Attributes meanAttributes(const std::array<int, 3>& c) const {
         const Attributes a = attributes(c[0]), b = attributes(c[1]), d = attributes(c[2]);
+        Mesh::Point mean = a.point;  // its first corner's id
+        mean.velocity = (a.point.velocity + b.point.velocity + d.point.velocity) / 3.0f;
+        mean.damage = (a.point.damage + b.point.damage + d.point.damage) / 3.0f;
+        mean.rest = (a.point.rest + b.point.rest + d.point.rest) / 3.0f;
         return {(a.colour + b.colour + d.colour) / 3.0f, (a.layer + b.layer + d.layer) / 3.0f,
-                (a.theta + b.theta + d.theta) / 3.0f};
+                (a.theta + b.theta + d.theta) / 3.0f, mean};
+    }
+
+    static Mesh::Point withRest(Mesh::Point p, const Eigen::Vector3f& rest) {
+        p.rest = rest;
+        return p;
+    }
+
+    /// A crack lip on particle i's side: i's point data, at the crossing's rest position.
+    Attributes withPoint(Attributes a, int i, const Eigen::Vector3f& rest) const {
+        a.point = withRest(point(i), rest);
+        return a;
     }
 
     Eigen::Vector3d x(int v) const { return placed_.x(v); }
@@ -508,6 +540,7 @@ private:
         mesh_.colors.push_back(attributes.colour);
         if (!layers_.empty()) mesh_.layers.push_back(attributes.layer);
         if (!theta_.empty()) mesh_.theta.push_back(attributes.theta);
+        mesh_.points.push_back(attributes.point);
         return static_cast<std::uint32_t>(mesh_.positions.size() - 1);
     }
 
@@ -625,6 +658,8 @@ private:
     std::vector<Eigen::Vector3f> colours_;
     std::vector<Eigen::Vector2f> layers_;  ///< empty where a colour map replaces the look
     std::span<const double> theta_;        ///< the frame's; empty without diffusion (EXR layer)
+    std::span<const Eigen::Vector3d> velocities_;  ///< the frame's; empty in some tests
+    std::span<const double> damage_;               ///< the frame's; empty if nothing breaks
     Mesh& mesh_;
     std::uint32_t lipBase_ = 0;
     static constexpr int kNotFitted = -1, kNoFit = -2;

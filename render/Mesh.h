@@ -18,6 +18,17 @@ struct Mesh {
     /// (ColorMap.h particleLayers); empty where a colour map replaces the look.
     std::vector<Eigen::Vector2f> layers;
     std::vector<float> theta;  ///< per vertex, the diffusing quantity; empty when there is none
+    /// Per vertex, what the simulation knows of it, for exports: the particle it belongs to (a
+    /// crack lip's or bow-tie copy's own particle; a triangle's centroid, its first corner), its
+    /// velocity, damage, and rest position (where textures stay put). Empty where a surface
+    /// does not follow particles (splat discs, the VDB level set).
+    struct Point {
+        std::int32_t id = -1;
+        Eigen::Vector3f velocity = Eigen::Vector3f::Zero();
+        float damage = 0.0f;
+        Eigen::Vector3f rest = Eigen::Vector3f::Zero();
+    };
+    std::vector<Point> points;
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 
@@ -30,7 +41,8 @@ inline void checkMesh(const Mesh& mesh, std::string_view who) {
     };
     if (mesh.normals.size() != n || (!mesh.colors.empty() && mesh.colors.size() != n) ||
         (!mesh.layers.empty() && mesh.layers.size() != n) ||
-        (!mesh.theta.empty() && mesh.theta.size() != n))
+        (!mesh.theta.empty() && mesh.theta.size() != n) ||
+        (!mesh.points.empty() && mesh.points.size() != n))
         fail("mesh attribute arrays differ in length");
     for (const auto& t : mesh.triangles)
         for (std::uint32_t v : t)

@@ -11,6 +11,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,14 @@ std::string plyHeader(const Mesh& mesh, bool normals, bool colors) {
     h += "property float x\nproperty float y\nproperty float z\n";
     if (normals) h += "property float nx\nproperty float ny\nproperty float nz\n";
     if (colors) h += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    if (!mesh.points.empty()) {
+        // s, t: the rest UV Blender reads; the rest as named values, with the particle id,
+        // velocity (motion blur), damage and theta, which Houdini reads as point attributes.
+        h += "property float s\nproperty float t\nproperty int id\n";
+        h += "property float vx\nproperty float vy\nproperty float vz\nproperty float damage\n";
+        h += "property float rest_x\nproperty float rest_y\nproperty float rest_z\n";
+        if (!mesh.theta.empty()) h += "property float theta\n";
+    }
     h += "element face " + std::to_string(mesh.triangles.size()) + "\n";
     h += "property list uchar uint vertex_indices\nend_header\n";
     return h;
@@ -72,13 +81,21 @@ void append(std::vector<char>& out, const T& value) {
 
 std::vector<char> plyBody(const Mesh& mesh, bool normals, bool colors) {
     std::vector<char> out;
-    out.reserve(mesh.positions.size() * 27 + mesh.triangles.size() * 13);
+    out.reserve(mesh.positions.size() * 75 + mesh.triangles.size() * 13);
+    const std::vector<Eigen::Vector2f> uv = restUv(mesh);
     for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
         for (int k = 0; k < 3; ++k) append(out, mesh.positions[v][k]);
         if (normals)
             for (int k = 0; k < 3; ++k) append(out, mesh.normals[v][k]);
         if (colors)
             for (int k = 0; k < 3; ++k) append(out, displayByte(mesh.colors[v][k]));
+        if (mesh.points.empty()) continue;
+        const Mesh::Point& p = mesh.points[v];
+        append(out, uv[v].x()), append(out, uv[v].y()), append(out, p.id);
+        for (int k = 0; k < 3; ++k) append(out, p.velocity[k]);
+        append(out, p.damage);
+        for (int k = 0; k < 3; ++k) append(out, p.rest[k]);
+        if (!mesh.theta.empty()) append(out, mesh.theta[v]);
     }
     for (const auto& t : mesh.triangles) {
         append(out, std::uint8_t{3});
@@ -119,6 +136,13 @@ void fillVertices(const Mesh& mesh, aiMesh& out) {
             const auto& m = mesh.normals[v];
             out.mNormals[v] = aiVector3D(m.x(), m.y(), m.z());
         }
+    }
+    if (mesh.points.size() == n) {  // glTF's TEXCOORD_0: the rest UV
+        const std::vector<Eigen::Vector2f> uv = restUv(mesh);
+        out.mTextureCoords[0] = new aiVector3D[n];
+        out.mNumUVComponents[0] = 2;
+        for (std::size_t v = 0; v < n; ++v)
+            out.mTextureCoords[0][v] = aiVector3D(uv[v].x(), uv[v].y(), 0);
     }
     if (mesh.colors.size() == n) {
         out.mColors[0] = new aiColor4D[n];
@@ -242,6 +266,23 @@ std::vector<fs::path> writeWithAssimp(const Mesh& mesh, const fs::path& path, Me
 }
 
 }  // namespace
+
+// Each vertex's rest position in [0, 1]^2 over the rest bounds of the sheet's vertices (its
+// rest x and y): a UV map that stays put on the sheet from frame to frame.
+std::vector<Eigen::Vector2f> restUv(const Mesh& mesh) {
+    Eigen::Vector2f low = Eigen::Vector2f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector2f high = -low;
+    for (const Mesh::Point& p : mesh.points) {
+        low = low.cwiseMin(p.rest.head<2>());
+        high = high.cwiseMax(p.rest.head<2>());
+    }
+    const Eigen::Vector2f size = (high - low).cwiseMax(Eigen::Vector2f::Constant(1e-30f));
+    std::vector<Eigen::Vector2f> uv;
+    uv.reserve(mesh.points.size());
+    for (const Mesh::Point& p : mesh.points)
+        uv.push_back((p.rest.head<2>() - low).cwiseQuotient(size));
+    return uv;
+}
 
 MeshFormat parseMeshFormat(std::string_view name) {
     std::string lower(name.substr(name.starts_with('.') ? 1 : 0));

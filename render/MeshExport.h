@@ -22,6 +22,10 @@ MeshFormat parseMeshFormat(std::string_view name);
 /// The usual file extension of a format, with the dot (".ply", ".obj", ".glb").
 std::string_view meshFormatExtension(MeshFormat format);
 
+/// Each vertex's rest position (Mesh::points) in [0, 1]^2 over the rest bounds of the mesh's
+/// vertices: a UV map that stays put on the sheet from frame to frame. Empty without points.
+std::vector<Eigen::Vector2f> restUv(const Mesh& mesh);
+
 /// Writes positions, triangles, per-vertex normals and colours: GLB as linear COLOR_0 (glTF's
 /// convention), PLY as 8-bit red/green/blue encoded with gamma 1/2.2 (viewers show PLY bytes
 /// as sRGB), OBJ only as the non-standard "v x y z r g b" extension. The files (OBJ's .mtl too)

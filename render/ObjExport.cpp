@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "render/AtomicFile.h"
+#include "render/MeshExport.h"
 
 namespace rend::render {
 
@@ -19,16 +20,18 @@ void appendNumber(std::string& out, float value) {
     out.append(text, end);
 }
 
-void appendIndex(std::string& out, std::uint32_t index, bool normals) {
+void appendIndex(std::string& out, std::uint32_t index, bool uv, bool normals) {
     const std::string one = std::to_string(index + 1);  // OBJ counts from 1
     out += ' ';
     out += one;
-    if (normals) out += "//" + one;
+    if (uv || normals) out += '/' + (uv ? one : std::string());
+    if (normals) out += '/' + one;
 }
 
 std::string objText(const Mesh& mesh, const std::string& library) {
     const std::size_t n = mesh.positions.size();
     const bool normals = mesh.normals.size() == n, colors = mesh.colors.size() == n;
+    const std::vector<Eigen::Vector2f> uv = restUv(mesh);
     std::string out =
         "# rend membrane surface: vertex i is the mesh's vertex i, the particles "
         "first, in order\nmtllib " +
@@ -42,6 +45,11 @@ std::string objText(const Mesh& mesh, const std::string& library) {
             for (int k = 0; k < 3; ++k) appendNumber(out, mesh.colors[v][k]);
         out += '\n';
     }
+    for (const Eigen::Vector2f& t : uv) {  // the rest UV, so textures stay on the sheet
+        out += "vt";
+        appendNumber(out, t.x()), appendNumber(out, t.y());
+        out += '\n';
+    }
     for (std::size_t v = 0; normals && v < n; ++v) {
         out += "vn";
         for (int k = 0; k < 3; ++k) appendNumber(out, mesh.normals[v][k]);
@@ -50,7 +58,7 @@ std::string objText(const Mesh& mesh, const std::string& library) {
     out += "usemtl membrane\n";
     for (const auto& t : mesh.triangles) {
         out += 'f';
-        for (const std::uint32_t i : t) appendIndex(out, i, normals);
+        for (const std::uint32_t i : t) appendIndex(out, i, !uv.empty(), normals);
         out += '\n';
     }
     return out;

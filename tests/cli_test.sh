@@ -211,7 +211,7 @@ check "full disk leaves no empty file" no_empty_files "$tmp/full"
 check "full disk leaves no partial files" no_partial_files "$tmp/full"
 check "full disk keeps stats.csv complete up to the failure" test "$(wc -l <"$tmp/full/stats.csv")" -ge 2
 check "full disk run.json says failed" test "$(json_status "$tmp/full/run.json")" = failed
-check "full disk at an OBJ exits 1" full_disk 40 scenes/stretch.toml "${small[@]}" --out "$tmp/fullobj" --export ply,obj
+check "full disk at an OBJ exits 1" full_disk 60 scenes/stretch.toml "${small[@]}" --out "$tmp/fullobj" --export ply,obj
 check "full disk names the OBJ" grep -q "cannot write $tmp/fullobj/meshes/frame_0001.obj: File too large" "$tmp/stderr"
 check "full disk leaves no OBJ nor its MTL" test ! -e "$tmp/fullobj/meshes/frame_0001.obj" -a ! -e "$tmp/fullobj/meshes/frame_0001.mtl"
 check "full disk lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['cache/source.toml','frames/frame_0001.png','meshes/frame_0001.ply','stats.csv'], f" "$tmp/fullobj/run.json"

@@ -917,6 +917,99 @@ TEST(MeshExport, PlyAndObjKeepEveryVertexAndTheSameLooseParts) {
     }
 }
 
+namespace {
+
+/// A PLY's vertex properties by name, each as floats (ints converted), from rend's layout.
+std::map<std::string, std::vector<float>> readPlyVertexProperties(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t body = text.find("end_header\n") + 11;
+    std::vector<std::pair<std::string, std::string>> properties;  // type, name
+    std::size_t vertices = 0;
+    std::istringstream header(text.substr(0, body));
+    for (std::string line; std::getline(header, line);) {
+        if (line.starts_with("element vertex ")) vertices = std::stoul(line.substr(15));
+        if (line.starts_with("element face")) break;
+        std::istringstream words(line);
+        std::string word, type, name;
+        if (words >> word >> type >> name && word == "property") properties.push_back({type, name});
+    }
+    std::map<std::string, std::vector<float>> values;
+    std::size_t at = body;
+    for (std::size_t v = 0; v < vertices; ++v)
+        for (const auto& [type, name] : properties) {
+            if (type == "uchar") {
+                values[name].push_back(float(std::uint8_t(text[at])));
+                at += 1;
+            } else if (type == "int") {
+                std::int32_t i;
+                std::memcpy(&i, text.data() + at, 4);
+                values[name].push_back(float(i));
+                at += 4;
+            } else {
+                float f;
+                std::memcpy(&f, text.data() + at, 4);
+                values[name].push_back(f);
+                at += 4;
+            }
+        }
+    return values;
+}
+
+}  // namespace
+
+// Issue 14: the PLY carries each vertex's particle id, velocity, damage and rest position (and
+// its rest UV as s, t); the OBJ and GLB carry the UV. A torn frame's lip vertices belong to
+// the particle of their side, at the crossing's rest position, so a texture runs on across the
+// crack.
+TEST(MeshExport, ExportsCarryTheParticlesIdsVelocitiesAndRestPositions) {
+    Sheet frame = membraneSheet(0.3, 0.2, kDx);
+    const LatticeSurface surface(frame.view());
+    for (int i = 0; i < frame.size(); ++i) {
+        frame.velocities[i] = Eigen::Vector3d(0.1 * i, -1.0, 0.5);
+        for (int b = frame.offsets[i]; b < frame.offsets[i + 1]; ++b)
+            if ((frame.rest[i].x() < 0.005) != (frame.rest[frame.partners[b]].x() < 0.005))
+                frame.breakBond(i, frame.partners[b]);
+    }
+    const Mesh mesh = surface.build(frame.view(), RenderSettings{});
+    ASSERT_GT(mesh.positions.size(), std::size_t(frame.size())) << "the crack has lips";
+    const fs::path dir = scratchDir("export_attributes");
+    rend::render::exportMesh(mesh, dir / "m.ply", MeshFormat::Ply);
+    auto ply = readPlyVertexProperties(dir / "m.ply");
+    ASSERT_EQ(ply["id"].size(), mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const int id = int(ply["id"][v]);
+        ASSERT_GE(id, 0);
+        ASSERT_LT(id, frame.size());
+        if (v < std::size_t(frame.size())) ASSERT_EQ(id, int(v)) << "vertex i is particle i";
+        EXPECT_NEAR(ply["vx"][v], 0.1f * float(id), 1e-4f) << v;
+        EXPECT_EQ(ply["vy"][v], -1.0f);
+        const Eigen::Vector3f rest(ply["rest_x"][v], ply["rest_y"][v], ply["rest_z"][v]);
+        // A lip lies on its particle's broken edge, a centroid in its particle's triangle.
+        EXPECT_LE((rest - frame.rest[std::size_t(id)].cast<float>()).norm(), 1.0001 * kDx) << v;
+        EXPECT_EQ(ply["damage"][v], 0.0f);
+        EXPECT_GE(ply["s"][v], 0.0f);
+        EXPECT_LE(ply["t"][v], 1.0f);
+    }
+    for (const MeshFormat format : {MeshFormat::Obj, MeshFormat::Glb}) {
+        const fs::path path =
+            dir / (std::string("m") + std::string(rend::render::meshFormatExtension(format)));
+        rend::render::exportMesh(mesh, path, format);
+        Assimp::Importer importer;
+        const aiScene* scene = importer.ReadFile(path.string(), 0);
+        ASSERT_TRUE(scene && scene->mNumMeshes == 1) << path;
+        const aiMesh& m = *scene->mMeshes[0];
+        ASSERT_TRUE(m.HasTextureCoords(0)) << path;
+        float low = 1, high = 0;
+        for (unsigned v = 0; v < m.mNumVertices; ++v) {
+            low = std::min({low, m.mTextureCoords[0][v].x, m.mTextureCoords[0][v].y});
+            high = std::max({high, m.mTextureCoords[0][v].x, m.mTextureCoords[0][v].y});
+        }
+        EXPECT_NEAR(low, 0.0f, 1e-6f) << path;
+        EXPECT_NEAR(high, 1.0f, 1e-6f) << path;
+    }
+}
+
 TEST(MeshExport, ExportedSurfacesKeepTheirTriangleCount) {
     const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     const Mesh mesh = LatticeSurface(frame.view()).build(frame.view(), RenderSettings{});

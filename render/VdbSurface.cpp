@@ -3,6 +3,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetFilter.h>
+#include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/ParticlesToLevelSet.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
@@ -335,7 +336,12 @@ void VdbSurface::writeVdb(const std::filesystem::path& path) const {
     if (!grid_) throw std::logic_error("VdbSurface::writeVdb called before build");
     std::ostringstream bytes(std::ios::binary);
     try {
-        MemoryArchive().writeTo(bytes, openvdb::GridCPtrVec{grid_->levelSet});
+        // Blender and most renderers shade a fog volume named "density", not a level set: the
+        // same grid as fog (1 inside, ramping to 0 across the inner half of the narrow band).
+        openvdb::FloatGrid::Ptr density = grid_->levelSet->deepCopy();
+        openvdb::tools::sdfToFogVolume(*density);
+        density->setName("density");
+        MemoryArchive().writeTo(bytes, openvdb::GridCPtrVec{grid_->levelSet, density});
     } catch (const std::exception& e) {
         throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
     }
@@ -350,6 +356,10 @@ VdbFileInfo inspectVdb(const std::filesystem::path& path) {
         VdbFileInfo info;
         openvdb::GridPtrVecPtr grids = file.getGrids();
         info.gridCount = grids->size();
+        for (const openvdb::GridBase::Ptr& grid : *grids) {
+            info.gridNames.push_back(grid->getName());
+            info.activeVoxels.push_back(grid->activeVoxelCount());
+        }
         if (!grids->empty()) {
             const openvdb::GridBase::Ptr& first = grids->front();
             info.firstGridName = first->getName();

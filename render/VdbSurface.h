@@ -67,6 +67,8 @@ struct VdbFileInfo {
     std::string firstGridName;
     std::uint64_t firstGridActiveVoxels = 0;
     double firstGridVoxelSize = 0.0;
+    std::vector<std::string> gridNames;       ///< in file order
+    std::vector<std::uint64_t> activeVoxels;  ///< per grid
 };
 
 /// Throws std::runtime_error when the file cannot be read.

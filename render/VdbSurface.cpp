@@ -69,6 +69,8 @@ public:
         getPos(n, xyz);
         radius = radius_;
     }
+    /// The attribute transferred to the voxels: the particle's index (the closest one wins).
+    void getAtt(std::size_t n, openvdb::Index32& index) const { index = openvdb::Index32(n); }
 
 private:
     std::span<const Eigen::Vector3d> positions_;
@@ -240,6 +242,7 @@ void nearestParticleColors(const sim::FrameView& frame, const RenderSettings& se
 
 struct VdbSurface::Grid {
     openvdb::FloatGrid::Ptr levelSet;
+    openvdb::FloatGrid::Ptr theta;  ///< the nearest particle's theta; null without diffusion
 };
 
 VdbSurface::VdbSurface(const sim::FrameView& rest, const VdbSettings& settings)
@@ -267,19 +270,30 @@ VdbSurface& VdbSurface::operator=(VdbSurface&&) noexcept = default;
 
 namespace {
 
-openvdb::FloatGrid::Ptr rasterize(std::span<const Eigen::Vector3d> positions, double voxel,
-                                  double radius, int& dropped) {
+/// The level set, and with `theta` a grid of the nearest particle's theta over its band.
+std::pair<openvdb::FloatGrid::Ptr, openvdb::FloatGrid::Ptr> rasterize(
+    std::span<const Eigen::Vector3d> positions, std::span<const double> theta, double voxel,
+    double radius, int& dropped) {
     openvdb::FloatGrid::Ptr grid =
         openvdb::createLevelSet<openvdb::FloatGrid>(voxel, kHalfWidthVoxels);
     grid->setName(kGridName);
-    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid> raster(*grid);
+    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid, openvdb::Index32> raster(*grid);
     // The constructor already refused radii below 1.5 voxels; the slack only keeps a radius of
     // exactly 1.5 voxels from being dropped by rounding in radius / voxel.
     raster.setRmin(kMinRadiusVoxels * (1.0 - 1e-9));
     raster.rasterizeSpheres(ParticleList(positions, radius));
     raster.finalize(/*prune=*/true);
     dropped = int(raster.getMinCount() + raster.getMaxCount());
-    return grid;
+    if (theta.empty()) return {grid, nullptr};
+    const auto nearest = raster.attributeGrid();
+    openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(0.0f);
+    values->setTransform(grid->transform().copy());
+    values->setName("theta");
+    values->setGridClass(openvdb::GRID_FOG_VOLUME);
+    auto out = values->getAccessor();
+    for (auto v = nearest->cbeginValueOn(); v; ++v)
+        if (*v < theta.size()) out.setValue(v.getCoord(), float(theta[*v]));
+    return {grid, values};
 }
 
 // Mean-curvature flow moves a flat sheet's faces not at all and fills the dimples between
@@ -315,7 +329,7 @@ Mesh zeroCrossing(const openvdb::FloatGrid& grid, double adaptivity) {
 }  // namespace
 
 Mesh VdbSurface::build(const sim::FrameView& frame, const RenderSettings& settings) {
-    openvdb::FloatGrid::Ptr grid = rasterize(frame.positions, voxelSize_, radius_, dropped_);
+    auto [grid, theta] = rasterize(frame.positions, frame.theta, voxelSize_, radius_, dropped_);
     smooth(*grid, smoothingIterations_);
     Mesh mesh = zeroCrossing(*grid, adaptivity_);
     orientOutward(mesh);
@@ -324,7 +338,7 @@ Mesh VdbSurface::build(const sim::FrameView& frame, const RenderSettings& settin
     // radii find it in the first ring of cells (cells of one radius needed a second ring, 5x
     // the lookups, for most vertices).
     nearestParticleColors(frame, settings, mesh, 2.0 * radius_);
-    grid_ = std::make_unique<Grid>(Grid{std::move(grid)});
+    grid_ = std::make_unique<Grid>(Grid{std::move(grid), std::move(theta)});
     return mesh;
 }
 
@@ -341,7 +355,9 @@ void VdbSurface::writeVdb(const std::filesystem::path& path) const {
         openvdb::FloatGrid::Ptr density = grid_->levelSet->deepCopy();
         openvdb::tools::sdfToFogVolume(*density);
         density->setName("density");
-        MemoryArchive().writeTo(bytes, openvdb::GridCPtrVec{grid_->levelSet, density});
+        openvdb::GridCPtrVec grids{grid_->levelSet, density};
+        if (grid_->theta) grids.push_back(grid_->theta);  // for shading by the diffusing quantity
+        MemoryArchive().writeTo(bytes, grids);
     } catch (const std::exception& e) {
         throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
     }
@@ -359,6 +375,13 @@ VdbFileInfo inspectVdb(const std::filesystem::path& path) {
         for (const openvdb::GridBase::Ptr& grid : *grids) {
             info.gridNames.push_back(grid->getName());
             info.activeVoxels.push_back(grid->activeVoxelCount());
+            std::array<float, 2> range{0.0f, 0.0f};
+            if (const auto floats = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) {
+                range = {std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
+                for (auto v = floats->cbeginValueOn(); v; ++v)
+                    range = {std::min(range[0], *v), std::max(range[1], *v)};
+            }
+            info.range.push_back(range);
         }
         if (!grids->empty()) {
             const openvdb::GridBase::Ptr& first = grids->front();

@@ -5,6 +5,7 @@
 // "pillow" about 1.5 dx thick for a sheet) that opens wherever the particles separate.
 // OpenVDB stays out of this header: rend_render links it privately.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -69,6 +70,7 @@ struct VdbFileInfo {
     double firstGridVoxelSize = 0.0;
     std::vector<std::string> gridNames;       ///< in file order
     std::vector<std::uint64_t> activeVoxels;  ///< per grid
+    std::vector<std::array<float, 2>> range;  ///< per float grid, its active values' min and max
 };
 
 /// Throws std::runtime_error when the file cannot be read.

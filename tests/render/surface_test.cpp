@@ -414,6 +414,31 @@ TEST(VdbSurface, WrittenGridReadsBackWithTheSameActiveVoxels) {
     EXPECT_FALSE(anyTmpLeft(dir));
 }
 
+// Issue 14: a sheet with a diffusing quantity writes it as a grid "theta" beside the level set
+// and the fog, each voxel holding its nearest particle's value; "density" is 1 inside.
+TEST(VdbSurface, ThetaIsWrittenAsAGridOfTheNearestParticlesValue) {
+    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
+    std::vector<double> theta(std::size_t(frame.size()));
+    for (int i = 0; i < frame.size(); ++i) theta[std::size_t(i)] = 2.0 + frame.rest[i].x();
+    rend::sim::FrameView view = frame.view();
+    view.theta = theta;
+    VdbSurface surface(view, VdbSettings{});
+    surface.build(view, RenderSettings{});
+    const fs::path dir = scratchDir("vdb_theta");
+    surface.writeVdb(dir / "frame_0001.vdb");
+    const auto info = rend::render::inspectVdb(dir / "frame_0001.vdb");
+    ASSERT_EQ(info.gridNames.size(), 3u);
+    std::map<std::string, std::array<float, 2>> range;
+    for (std::size_t k = 0; k < info.gridNames.size(); ++k)
+        range[info.gridNames[k]] = info.range[k];
+    ASSERT_EQ(range.count("theta"), 1u);
+    const auto [low, high] = std::minmax_element(theta.begin(), theta.end());
+    EXPECT_NEAR(range["theta"][0], *low, 1e-6);
+    EXPECT_NEAR(range["theta"][1], *high, 1e-6);
+    EXPECT_NEAR(range["density"][1], 1.0f, 1e-6f);
+    EXPECT_GE(range["density"][0], 0.0f);
+}
+
 TEST(VdbSurface, RadiusBelowOneAndAHalfVoxelsIsRefused) {
     const Sheet frame = membraneSheet(0.2, 0.2, kDx);
     VdbSettings settings;

@@ -93,14 +93,16 @@ TEST(StatsWriter, FinishRenamesTheRowsIntoPlace) {
     const fs::path dir = folderWith("stats_ok", {});
     fs::create_directories(dir);
     StatsWriter stats(dir / "stats.csv");
-    stats.append({1, 0.5, 1.0, 2.0, 3.0, 0.0, 7});
+    stats.append({1, 0.5, 1.0, 2.0, 3.0, 0.0, 7, 120, 2.5e-4});
     EXPECT_TRUE(stats.finish());
     EXPECT_FALSE(stats.finish());
     std::ifstream in(dir / "stats.csv");
     std::string header, row;
     std::getline(in, header);
     std::getline(in, row);
-    EXPECT_EQ(row, "1,0.5,1,2,3,0,7");
+    EXPECT_EQ(header,
+              "frame,time,kinetic_energy,strain_energy,max_speed,max_theta,broken_bonds,steps,dt");
+    EXPECT_EQ(row, "1,0.5,1,2,3,0,7,120,0.00025");
     EXPECT_FALSE(fs::exists(dir / "stats.csv.partial"));
 }
 

@@ -9,13 +9,15 @@
 #include <iterator>
 #include <random>
 
+#include "tests/ScratchDir.h"
+
 namespace fs = std::filesystem;
 using namespace rend;
 
 namespace {
 
 fs::path freshDir(const char* name) {
-    const fs::path dir = fs::temp_directory_path() / name;
+    const fs::path dir = test::scratchDir() / name;
     fs::remove_all(dir);
     return dir;
 }

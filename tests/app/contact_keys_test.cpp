@@ -9,6 +9,7 @@
 
 #include "app/Scene.h"
 #include "app/SceneError.h"
+#include "tests/ScratchDir.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -26,7 +27,7 @@ density = 5000
 )";
 
 fs::path writeScene(const std::string& text) {
-    const fs::path dir = fs::temp_directory_path() / "rend_contact_keys_test";
+    const fs::path dir = test::scratchDir();
     fs::create_directories(dir);
     const fs::path file = dir / "scene.toml";
     std::ofstream(file) << kSheet << text;
@@ -117,7 +118,7 @@ TEST(ContactKeys, EveryMistakeIsRefusedAtItsLocation) {
 }
 
 TEST(ContactKeys, AnOpenMeshIsRefusedWithItsOpenEdgeCount) {
-    const fs::path dir = fs::temp_directory_path() / "rend_contact_keys_test";
+    const fs::path dir = test::scratchDir();
     fs::create_directories(dir);
     std::ofstream(dir / "quad.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
     expectRefused("[[collider]]\nshape = \"mesh\"\nfile = \"quad.obj\"\n", 11, "4 open edges");

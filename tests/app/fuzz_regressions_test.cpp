@@ -11,6 +11,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "fuzz/FuzzInput.h"
+#include "tests/ScratchDir.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -37,7 +38,7 @@ std::string readBytes(const fs::path& file) {
 /// Loads one fuzz input the way the harness does; returns "loaded" or "refused".
 std::string replay(const fs::path& input) {
     const fuzz::FuzzInput split = fuzz::splitFuzzInput(readBytes(input));
-    const fs::path scene = fs::temp_directory_path() / "rend_fuzz_replay.toml";
+    const fs::path scene = test::scratchDir() / "replay.toml";
     std::ofstream(scene, std::ios::binary | std::ios::trunc) << split.scene;
     try {
         loadScene(scene, split.sets);

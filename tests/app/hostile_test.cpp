@@ -14,6 +14,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneReader.h"
+#include "tests/ScratchDir.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -70,7 +71,7 @@ renderer = "none"
 )";
 
 fs::path writeScene(const std::string& name, const std::string& text) {
-    const fs::path dir = fs::temp_directory_path() / "rend_hostile_test";
+    const fs::path dir = test::scratchDir();
     fs::create_directories(dir);
     std::ofstream(dir / name) << text;
     return dir / name;

@@ -17,6 +17,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneReader.h"
+#include "tests/ScratchDir.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -360,7 +361,7 @@ TEST(EveryKey, HasAVariationInThisTest) {
 }
 
 TEST(EveryKey, ChangesTheRunOrItsOutput) {
-    const fs::path root = fs::temp_directory_path() / "rend_keys_test";
+    const fs::path root = test::scratchDir();
     // The control: the same scene twice gives the same fingerprint, frames included.
     const std::string base = fingerprint(kBase, {}, false, root);
     ASSERT_EQ(base, fingerprint(kBase, {}, false, root));

@@ -11,6 +11,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneReader.h"
+#include "tests/ScratchDir.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -105,7 +106,7 @@ renderer = "none"
 )";
 
 fs::path writeScene(const std::string& name, const std::string& text) {
-    const fs::path dir = fs::temp_directory_path() / "rend_schema_test";
+    const fs::path dir = test::scratchDir();
     fs::create_directories(dir);
     std::ofstream(dir / name) << text;
     return dir / name;
@@ -203,7 +204,7 @@ TEST(SceneSchema, TheStableStepBoundIsLocatedAtDt) {
 
 TEST(SceneSchema, StatsFalseWritesNoStatsFile) {
     const fs::path file = writeScene("small.toml", kSmall);
-    const fs::path out = fs::temp_directory_path() / "rend_schema_test" / "no_stats";
+    const fs::path out = test::scratchDir() / "no_stats";
     fs::remove_all(out);
     RunOptions options;
     options.outDir = out;

@@ -9,6 +9,7 @@
 
 #include "render/EmbreeRenderer.h"
 #include "render/ExrWriter.h"
+#include "tests/ScratchDir.h"
 
 using rend::render::EmbreeRenderer;
 using rend::render::FrameLayers;
@@ -140,7 +141,7 @@ TEST(ExrWriter, WritesAndReadsBackEveryChannelWithItsValues) {
         layers.depth.push_back(1.0f + 0.001f * float(i));
         for (float v : {0.0f, 0.6f, 0.8f}) layers.normal.push_back(v);
     }
-    const auto path = std::filesystem::temp_directory_path() / "rend_exr_test.exr";
+    const auto path = rend::test::scratchDir() / "layers.exr";
     rend::render::writeExrAtomic(layers, path);
     EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
     const rend::render::ExrChannels read = rend::render::readExr(path);

@@ -26,6 +26,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "sim/Membrane.h"
+#include "tests/ScratchDir.h"
 #include "tests/sim/Peridynamic.h"
 
 using namespace rend;
@@ -248,7 +249,7 @@ TEST(Stability, SeededParameterFuzzEndsInAResultOrAClearError) {
     // (Ok), in a SceneError (Refused) or in NumericalBlowUp (Caught), with a clear message; at
     // dt <= the bound only the power law (stiffening without limit under compression) is caught.
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / "rend_validation_stability";
+    const fs::path dir = test::scratchDir();
     fs::create_directories(dir);
     const fs::path plain = dir / "fuzz.toml", notched = dir / "fuzz_notch.toml";
     std::ofstream(plain) << kFuzzScene;

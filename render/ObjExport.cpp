@@ -56,6 +56,9 @@ std::string objText(const Mesh& mesh, const std::string& library) {
         out += '\n';
     }
     out += "usemtl membrane\n";
+    // Smoothing group 1: Blender's importer (3.4) leaves faces flat without it, and with them
+    // flat it ignores the vn normals it keeps as custom normals.
+    if (normals) out += "s 1\n";
     for (const auto& t : mesh.triangles) {
         out += 'f';
         for (const std::uint32_t i : t) appendIndex(out, i, !uv.empty(), normals);

@@ -45,6 +45,15 @@ def parse_args():
     p.add_argument("--height", type=int)
     p.add_argument("--exr-dir", type=pathlib.Path)
     p.add_argument("--reference", action="store_true")
+    p.add_argument("--save", type=pathlib.Path, help="write the shot to this .blend")
+    p.add_argument("--volume", action="store_true",
+                   help="render the vdb/ sequence (its density grid) instead of the meshes")
+    p.add_argument("--motion-blur", action="store_true",
+                   help="Cycles' motion blur from the velocity attribute")
+    p.add_argument("--no-render", action="store_true", help="import (and save) only")
+    p.add_argument("--report", action="store_true",
+                   help="print each frame's mesh and attributes at the rendered frame")
+    return p.parse_args(argv)
     return p.parse_args(argv)
 
 
@@ -60,6 +69,7 @@ def vertex_colour_material(render):
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
     bsdf = nodes["Principled BSDF"]
     colour = nodes.new("ShaderNodeVertexColor")
+    colour.layer_name = "Col"
     links.new(colour.outputs["Color"], bsdf.inputs["Base Color"])
     kind = render.get("material", "diffuse")
     inputs = bsdf.inputs
@@ -86,24 +96,162 @@ def vertex_colour_material(render):
     return mat
 
 
+PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "<i2", "ushort": "<u2", "int": "<i4",
+             "uint": "<u4", "float": "<f4", "double": "<f8"}
+
+
+def read_ply(path):
+    """rend's binary little-endian PLY: the vertex table as a numpy record array, and the
+    triangles as an (M, 3) index array. rend writes triangles only."""
+    import numpy
+    with open(path, "rb") as f:
+        lines = []
+        while not lines or lines[-1] != "end_header":
+            line = f.readline()
+            if not line:
+                sys.exit(f"blender_import: {path}: no end_header")
+            lines.append(line.decode("ascii").strip())
+        body = f.read()
+    if "format binary_little_endian 1.0" not in lines:
+        sys.exit(f"blender_import: {path}: not a binary little-endian PLY written by rend")
+    fields, counts, element = [], {}, None
+    for line in lines:
+        words = line.split()
+        if words[0] == "element":
+            element = words[1]
+            counts[element] = int(words[2])
+        elif words[0] == "property" and element == "vertex":
+            fields.append((words[2], PLY_TYPES[words[1]]))
+    vertices = numpy.frombuffer(body, numpy.dtype(fields), count=counts["vertex"])
+    faces = numpy.frombuffer(body, numpy.dtype([("n", "u1"), ("v", "<u4", 3)]),
+                             count=counts.get("face", 0), offset=vertices.nbytes)
+    if len(faces) and (faces["n"] != 3).any():
+        sys.exit(f"blender_import: {path}: a face that is not a triangle")
+    return vertices, faces["v"].astype(numpy.int64)
+
+
+def add_point_attribute(mesh, name, kind, values):
+    attribute = mesh.attributes.new(name, kind, "POINT")
+    attribute.data.foreach_set("vector" if kind == "FLOAT_VECTOR" else "value",
+                               values.ravel())
+
+
+def frame_mesh(path, number):
+    """One frame as a mesh: rend's normals as custom split normals, the colour, the rest UV,
+    and every per-point value of the PLY as a named attribute (id, velocity in m/s for
+    Cycles' motion blur, theta, damage, rest)."""
+    import numpy
+    vertices, triangles = read_ply(path)
+    names = vertices.dtype.names
+    column = lambda *keys: numpy.stack([vertices[k] for k in keys], axis=1).astype(numpy.float32)
+    mesh = bpy.data.meshes.new(f"rend_frame_{number:04d}")
+    mesh.use_fake_user = True  # kept in a saved .blend while another frame is shown
+    mesh.vertices.add(len(vertices))
+    mesh.vertices.foreach_set("co", column("x", "y", "z").ravel())
+    mesh.loops.add(3 * len(triangles))
+    mesh.loops.foreach_set("vertex_index", triangles.ravel())
+    mesh.polygons.add(len(triangles))
+    mesh.polygons.foreach_set("loop_start", numpy.arange(0, 3 * len(triangles), 3))
+    mesh.polygons.foreach_set("loop_total", numpy.full(len(triangles), 3))
+    mesh.polygons.foreach_set("use_smooth", numpy.ones(len(triangles), dtype=bool))
+    mesh.update(calc_edges=True)
+    if "nx" in names:
+        mesh.use_auto_smooth = True
+        mesh.normals_split_custom_set_from_vertices(column("nx", "ny", "nz"))
+    if "red" in names:
+        rgba = numpy.ones((len(vertices), 4), numpy.float32)
+        rgba[:, :3] = column("red", "green", "blue") / 255.0
+        colours = mesh.color_attributes.new("Col", "BYTE_COLOR", "POINT")
+        colours.data.foreach_set("color_srgb", rgba.ravel())
+    if "s" in names:
+        uv = mesh.uv_layers.new(name="rest_uv")
+        uv.data.foreach_set("uv", column("s", "t")[triangles.ravel()].ravel())
+    if "id" in names:
+        add_point_attribute(mesh, "id", "INT", vertices["id"].astype(numpy.int32))
+    if "vx" in names:
+        add_point_attribute(mesh, "velocity", "FLOAT_VECTOR", column("vx", "vy", "vz"))
+    for name in ("theta", "damage"):
+        if name in names:
+            add_point_attribute(mesh, name, "FLOAT", vertices[name].astype(numpy.float32))
+    if "rest_x" in names:
+        add_point_attribute(mesh, "rest", "FLOAT_VECTOR", column("rest_x", "rest_y", "rest_z"))
+    return mesh
+
+
+# Saved into the .blend as a registered text block, so that the sheet follows the timeline
+# there too (Blender runs it on load when the file's scripts are trusted).
+FRAME_HANDLER = '''
+import bpy
+
+
+def rend_show_frame(scene, depsgraph=None):
+    """Puts the mesh of the latest rend frame at or before the current frame on the sheet."""
+    sheet = bpy.data.objects.get("rend_sheet")
+    if sheet is None:
+        return
+    frames = list(sheet["rend_frames"])
+    shown = frames[0]
+    for number in frames:
+        if number <= scene.frame_current:
+            shown = number
+    mesh = bpy.data.meshes.get("rend_frame_%04d" % shown)
+    if mesh is not None and sheet.data != mesh:
+        sheet.data = mesh
+
+
+for handler in list(bpy.app.handlers.frame_change_pre):
+    if getattr(handler, "__name__", "") == "rend_show_frame":
+        bpy.app.handlers.frame_change_pre.remove(handler)
+bpy.app.handlers.frame_change_pre.append(rend_show_frame)
+'''
+
+
 def import_sequence(mesh_dir, material):
-    frames = sorted(mesh_dir.glob("frame_*.ply"))
-    if not frames:
+    """Every meshes/frame_NNNN.ply as one object, rend_sheet, whose mesh is that frame's on
+    Blender's frame NNNN. Returns the frame numbers."""
+    paths = sorted(mesh_dir.glob("frame_*.ply"))
+    if not paths:
         sys.exit(f"blender_import: no meshes/frame_*.ply in {mesh_dir}")
-    for path in frames:
-        number = int(path.stem.split("_")[1])
-        bpy.ops.import_mesh.ply(filepath=str(path))
-        obj = bpy.context.selected_objects[0]
-        obj.data.materials.append(material)
-        # rend interpolates the exported vertex normals (a crack's two lips have their own
-        # vertices, so this does not smooth across it).
-        obj.data.polygons.foreach_set("use_smooth", [True] * len(obj.data.polygons))
-        # Visible on its own frame only: keyframe the visibility around it.
-        for frame, hidden in ((number - 1, True), (number, False), (number + 1, True)):
-            obj.hide_render = obj.hide_viewport = hidden
-            obj.keyframe_insert("hide_render", frame=frame)
-            obj.keyframe_insert("hide_viewport", frame=frame)
-    return len(frames)
+    numbers = [int(path.stem.split("_")[1]) for path in paths]
+    for path, number in zip(paths, numbers):
+        frame_mesh(path, number).materials.append(material)
+    sheet = bpy.data.objects.new("rend_sheet", bpy.data.meshes[f"rend_frame_{numbers[0]:04d}"])
+    sheet["rend_frames"] = numbers
+    bpy.context.scene.collection.objects.link(sheet)
+    text = bpy.data.texts.new("rend_frames.py")
+    text.write(FRAME_HANDLER)
+    text.use_module = True
+    exec(compile(FRAME_HANDLER, "rend_frames.py", "exec"), {"__name__": "rend_frames"})
+    return numbers
+
+
+def import_volumes(vdb_dir):
+    """vdb/frame_NNNN.vdb as one volume object, rend_volume, showing file NNNN on Blender's
+    frame NNNN (Blender's importer would start any sequence on frame 1), shaded by its
+    density grid. Returns the frame numbers, or [] without a vdb folder."""
+    paths = sorted(vdb_dir.glob("frame_*.vdb")) if vdb_dir.is_dir() else []
+    if not paths:
+        return []
+    numbers = [int(path.stem.split("_")[1]) for path in paths]
+    volume = bpy.data.volumes.new("rend_volume")
+    volume.filepath = str(paths[0])
+    volume.is_sequence = True
+    # File number = Blender frame - frame_start + 1 + frame_offset, within the duration.
+    volume.frame_start = 1
+    volume.frame_offset = 0
+    volume.frame_duration = numbers[-1]
+    volume.sequence_mode = "CLIP"
+    mat = bpy.data.materials.new("rend_volume")
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    shader = nodes.new("ShaderNodeVolumePrincipled")
+    shader.inputs["Density"].default_value = 50.0
+    mat.node_tree.links.new(shader.outputs["Volume"], nodes["Material Output"].inputs["Volume"])
+    volume.materials.append(mat)
+    obj = bpy.data.objects.new("rend_volume", volume)
+    bpy.context.scene.collection.objects.link(obj)
+    return numbers
 
 
 def add_camera(cam):
@@ -200,6 +348,51 @@ def render_exr_series(scene, counts, exr_dir):
         print(f"cycles spp={count} seconds={best:.4f} cpu={best_cpu:.4f}", flush=True)
 
 
+def loose_parts(mesh):
+    """The mesh's connected pieces of faces, as Blender's 'Separate by loose parts' finds."""
+    parent = list(range(len(mesh.vertices)))
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    for edge in mesh.edges:
+        a, b = root(edge.vertices[0]), root(edge.vertices[1])
+        parent[a] = b
+    used = {v for poly in mesh.polygons for v in poly.vertices}
+    return len({root(v) for v in used})
+
+
+def report(scene, volume):
+    """One line a test can read: what the sheet (or the volume) shows on this frame."""
+    sheet = bpy.data.objects["rend_sheet"]
+    mesh = sheet.data
+    attrs = {a.name: f"{a.domain}:{a.data_type}" for a in mesh.attributes
+             if not a.name.startswith(".")}
+    print(f"report frame={scene.frame_current} object={sheet.name} mesh={mesh.name} "
+          f"vertices={len(mesh.vertices)} faces={len(mesh.polygons)} "
+          f"loose_parts={loose_parts(mesh)} "
+          f"smooth={sum(p.use_smooth for p in mesh.polygons)} "
+          f"custom_normals={int(mesh.has_custom_normals)} "
+          f"uv={','.join(uv.name for uv in mesh.uv_layers)} "
+          f"attributes={','.join(f'{k}={v}' for k, v in sorted(attrs.items()))}")
+    if "id" in mesh.attributes:
+        ids = [d.value for d in mesh.attributes["id"].data]
+        print(f"report ids first={ids[:3]} max={max(ids)}")
+    if "velocity" in mesh.attributes:
+        v = mesh.attributes["velocity"].data[0].vector
+        print(f"report velocity0={v[0]:.6g},{v[1]:.6g},{v[2]:.6g}")
+    objects = [o.name for o in bpy.data.objects if o.type in ("MESH", "VOLUME")]
+    print(f"report objects={','.join(sorted(objects))}")
+    if "rend_volume" in bpy.data.objects:
+        grids = bpy.data.objects["rend_volume"].data.grids
+        grids.load()
+        print(f"report volume_frame={grids.frame} file={pathlib.Path(grids.frame_filepath).name} "
+              f"grids={','.join(sorted(g.name for g in grids))}")
+
+
 def main():
     args = parse_args()
     run = json.loads((args.out_dir / "run.json").read_text())
@@ -209,8 +402,14 @@ def main():
     clear_scene()
     # "shading" is the material as rend resolved it (the look's preset under the scene's keys);
     # the resolved scene alone lacks the look's defaults.
-    count = import_sequence(args.out_dir / "meshes",
-                            vertex_colour_material(run.get("shading", render)))
+    numbers = import_sequence(args.out_dir / "meshes",
+                              vertex_colour_material(run.get("shading", render)))
+    volumes = import_volumes(args.out_dir / "vdb")
+    if args.volume and not volumes:
+        sys.exit(f"blender_import: --volume, but no vdb/frame_*.vdb in {args.out_dir}")
+    bpy.data.objects["rend_sheet"].hide_render = args.volume
+    if volumes:
+        bpy.data.objects["rend_volume"].hide_render = not args.volume
     add_camera(scene_json.get("camera", {}))
     add_lights(scene_json.get("light", {}), render, background)
     add_ground(render, scene_json.get("sheet", {}))
@@ -230,7 +429,17 @@ def main():
     scene.render.resolution_x = args.width or render.get("width", 960)
     scene.render.resolution_y = args.height or render.get("height", 540)
     scene.render.resolution_percentage = 100
+    scene.frame_start, scene.frame_end = numbers[0], numbers[-1]
+    scene.render.fps = int(scene_json.get("time", {}).get("fps", 24))
+    scene.render.use_motion_blur = args.motion_blur
     scene.frame_set(args.frame)
+    if args.report:
+        report(scene, args.volume)
+    if args.save:
+        bpy.ops.wm.save_as_mainfile(filepath=str(args.save.resolve()))
+        print(f"blender_import: saved {args.save}")
+    if args.no_render:
+        return
     counts = [int(c) for c in args.samples.split(",")]
     if args.exr_dir:
         render_exr_series(scene, counts, args.exr_dir)
@@ -241,7 +450,7 @@ def main():
     start = time.perf_counter()
     bpy.ops.render.render(write_still=True)
     seconds = time.perf_counter() - start
-    print(f"blender_import: {count} meshes, frame {args.frame} -> {output}")
+    print(f"blender_import: {len(numbers)} meshes, frame {args.frame} -> {output}")
     print(f"render_seconds={seconds:.3f}")
     print(f"coverage={coverage(output, background):.3f}")
 

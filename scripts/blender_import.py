@@ -455,4 +455,5 @@ def main():
     print(f"coverage={coverage(output, background):.3f}")
 
 
-main()
+if __name__ == "__main__":
+    main()

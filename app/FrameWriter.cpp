@@ -11,6 +11,7 @@
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
 #include "render/OsmesaRenderer.h"
+#include "render/SheetVolume.h"
 #include "render/SplatSurface.h"
 #include "render/VdbSurface.h"
 
@@ -49,7 +50,8 @@ const render::Mesh& asMesh(const render::Geometry& geometry, render::Mesh& scrat
 struct FrameWriter::Parts {
     std::unique_ptr<render::LatticeSurface> lattice;
     std::unique_ptr<render::SplatSurface> splat;
-    std::unique_ptr<render::VdbSurface> vdb;  ///< the vdb surface, or the level set for export
+    std::unique_ptr<render::VdbSurface> vdb;
+    double exportVoxel = 0.0;  ///< the exported volume's, resolved on its first frame
     std::unique_ptr<render::OsmesaRenderer> osmesa;
     std::unique_ptr<render::EmbreeRenderer> embree;
 };
@@ -114,6 +116,19 @@ render::Image FrameWriter::renderImage(const sim::FrameView& view, const render:
     return p.osmesa->render(asMesh(geometry, scratch), scene_.render, colliders);
 }
 
+const render::Mesh& FrameWriter::midSurface(const sim::FrameView& view,
+                                            const render::Geometry& geometry,
+                                            render::Mesh& scratch) {
+    if (scene_.render.surface == render::SurfaceKind::Lattice && scene_.render.thickness == 0.0)
+        return std::get<render::Mesh>(geometry);
+    Parts& p = *parts_;
+    if (!p.lattice) p.lattice = std::make_unique<render::LatticeSurface>(view);
+    render::RenderSettings flat = scene_.render;
+    flat.thickness = 0.0;
+    scratch = p.lattice->build(view, flat);
+    return scratch;
+}
+
 void FrameWriter::exportFrame(const sim::FrameView& view, const render::Geometry& geometry,
                               std::vector<std::string>& written) {
     render::Mesh scratch;
@@ -122,12 +137,13 @@ void FrameWriter::exportFrame(const sim::FrameView& view, const render::Geometry
         const std::filesystem::path path = outDir_ / name;
         std::filesystem::create_directories(path.parent_path());
         if (format == ExportFormat::Vdb) {
-            Parts& p = *parts_;
-            if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
-            // The vdb surface built its level set already; any other surface builds it here.
-            if (scene_.render.surface != render::SurfaceKind::Vdb)
-                p.vdb->build(view, scene_.render);
-            p.vdb->writeVdb(path);
+            // [render] vdb_voxel_size, or half the rest spacing as for the vdb surface.
+            double& voxel = parts_->exportVoxel;
+            if (voxel == 0.0) voxel = scene_.render.vdb.voxelSize;
+            if (voxel == 0.0) voxel = 0.5 * render::restSpacing(view);
+            render::Mesh mid;
+            lastVolume_ = render::writeSheetVolume(midSurface(view, geometry, mid), view.theta,
+                                                   voxel, scene_.sim.sheet.thickness, path);
             written.push_back(name);
             continue;
         }

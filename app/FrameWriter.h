@@ -13,6 +13,7 @@
 #include "render/ExrWriter.h"
 #include "render/Geometry.h"
 #include "render/Image.h"
+#include "render/SheetVolume.h"
 #include "sim/FrameView.h"
 
 namespace rend {
@@ -35,8 +36,15 @@ public:
     /// `written` as soon as it is complete (so a failed write leaves the list right).
     void write(const sim::FrameView& view, StageTimes& seconds, std::vector<std::string>& written);
 
+    /// The last exported volume's voxel size and thickness (render/SheetVolume.h); zeros before
+    /// the first `--export vdb` frame.
+    render::SheetVolumeInfo lastVolume() const { return lastVolume_; }
+
 private:
     render::Geometry buildSurface(const sim::FrameView& view);
+    /// The sheet's mid-surface (the lattice surface, not extruded) for the volume export.
+    const render::Mesh& midSurface(const sim::FrameView& view, const render::Geometry& geometry,
+                                   render::Mesh& scratch);
     bool writesExr() const;  ///< [output] exr with the path tracer
     /// The frame's PNG image; with the path tracer also its EXR layers when `layers` is given.
     render::Image renderImage(const sim::FrameView& view, const render::Geometry& geometry,
@@ -48,6 +56,7 @@ private:
     const Scene& scene_;
     std::filesystem::path outDir_;
     std::unique_ptr<Parts> parts_;
+    render::SheetVolumeInfo lastVolume_;
 };
 
 }  // namespace rend

@@ -166,6 +166,16 @@ std::string stateHash(const sim::Membrane& m) {
     return hex;
 }
 
+// The exported volume's resolution and the thickness it holds (null without --export vdb).
+std::string volumeJson(const render::SheetVolumeInfo& v, double sheetThickness) {
+    if (v.voxelSize == 0.0) return "null";
+    std::ostringstream j;
+    j.precision(10);
+    j << "{\"voxel_size\": " << v.voxelSize << ", \"thickness\": " << v.thickness
+      << ", \"sheet_thickness\": " << sheetThickness << "}";
+    return j.str();
+}
+
 std::string runJson(const Scene& scene, const RunSummary& s, const std::string& status,
                     const std::string& hash, const std::vector<std::string>& files) {
     std::ostringstream j;
@@ -191,6 +201,7 @@ std::string runJson(const Scene& scene, const RunSummary& s, const std::string& 
       << "  \"cache\": {\"frames\": " << s.framesCached << ", \"bytes\": " << s.cacheBytes
       << ", \"bytes_per_particle_frame\": "
       << (s.framesCached > 0 ? double(s.cacheBytes) / s.framesCached / s.particles : 0.0) << "},\n"
+      << "  \"vdb\": " << volumeJson(s.volume, scene.sim.sheet.thickness) << ",\n"
       << "  \"threads\": " << omp_get_max_threads() << ",\n"
       << "  \"wall_seconds\": {\"setup\": " << s.seconds.setup
       << ", \"simulate\": " << s.seconds.simulate << ", \"contact\": " << s.seconds.contact
@@ -513,6 +524,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             if (isSelected(frame) && writer.active()) {
                 membrane.updateDamage();
                 writer.write(membrane.view(frame), s.seconds, frameFiles);
+                s.volume = writer.lastVolume();
                 folder.wrote(frameFiles);
                 ++s.framesWritten;
             }

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "app/Scene.h"
+#include "render/SheetVolume.h"
 #include "sim/Membrane.h"
 
 namespace rend {
@@ -51,9 +52,10 @@ struct RunSummary {
     long contactListBuilds = 0;  ///< the self-contact's candidate-list builds
     int framesSimulated = 0;
     int framesWritten = 0;
-    int resumedAfter = 0;           ///< the cached frame a --resume continued from; 0: none
-    int framesCached = 0;           ///< cache files this run wrote
-    std::uintmax_t cacheBytes = 0;  ///< their bytes
+    int resumedAfter = 0;            ///< the cached frame a --resume continued from; 0: none
+    int framesCached = 0;            ///< cache files this run wrote
+    std::uintmax_t cacheBytes = 0;   ///< their bytes
+    render::SheetVolumeInfo volume;  ///< the exported VDB's voxel and thickness; zeros: none
     StageTimes seconds;
     double nsPerParticleStep = 0.0;
 };

@@ -514,7 +514,9 @@ constexpr Param kRender[] = {
     {"thickness", T::Number, closed(0.0, 100.0), "0",
      "the lattice surface's extruded thickness in metres", "0.002"},
     {"vdb_voxel_size", T::Number, closed(0.0, 1e3), "0 (dx / 2)",
-     "the level set's voxel size in metres", "0.01"},
+     "the level set's voxel size in metres (the vdb surface's, and the --export vdb volume's: "
+     "it holds the sheet's thickness down to 2 voxels)",
+     "0.01"},
     {"vdb_particle_radius", T::Number, closed(0.0, 1e3), "0 (0.75 dx)",
      "the particle radius in metres", "0.015"},
     {"vdb_smoothing", T::Integer, closed(0, 20), "1", "level-set smoothing iterations", "1"},

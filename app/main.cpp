@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -18,6 +19,8 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneNames.h"
+#include "render/SheetVolume.h"
+#include "render/SplatSurface.h"
 #include "render/Versions.h"
 #include "sim/SolverRegistry.h"
 
@@ -38,6 +41,28 @@ void printVersions() {
 std::vector<std::string> withQuality(std::vector<std::string> sets, const std::string& quality) {
     if (!quality.empty()) sets.push_back("sheet.quality=" + quality);
     return sets;
+}
+
+/// The exported VDB's voxel, the thickness it holds, and its size; with the voxel that holds
+/// the sheet's own thickness when that is another.
+void printVolumeEstimate(const rend::Scene& scene, const rend::sim::Membrane& membrane) {
+    const rend::sim::FrameView rest = membrane.view(0);
+    double area = 0.0;
+    for (const auto& t : rest.restTriangles)
+        area += 0.5 * (rest.restPositions[t[1]] - rest.restPositions[t[0]])
+                          .cross(rest.restPositions[t[2]] - rest.restPositions[t[0]])
+                          .norm();
+    const double h = scene.sim.sheet.thickness;
+    const auto line = [&](const char* what, double voxel) {
+        const double voxels = rend::render::sheetVolumeVoxels(area, voxel, h);
+        std::printf("  vdb%s: voxel %.3g m, %.3g m thick, about %.3g M voxels, %.3g MB a frame\n",
+                    what, voxel, rend::render::sheetVolumeThickness(h, voxel), voxels / 1e6,
+                    voxels * rend::render::kSheetVolumeBytesPerVoxel / 1e6);
+    };
+    const double voxel = scene.render.vdb.voxelSize > 0.0 ? scene.render.vdb.voxelSize
+                                                          : 0.5 * rend::render::restSpacing(rest);
+    line("", voxel);
+    if (voxel > 0.5 * h) line(" at the sheet's thickness (render.vdb_voxel_size = h / 2)", 0.5 * h);
 }
 
 int checkCommand(const std::string& file, const std::vector<std::string>& sets,
@@ -63,6 +88,8 @@ int checkCommand(const std::string& file, const std::vector<std::string>& sets,
         rend::SheetEstimate::kBytesPerBondEnd, rend::describeEstimate(estimate).c_str(),
         double(rend::cacheFrameBytes(membrane)) / 1e6,
         double(rend::cacheFrameBytes(membrane)) * scene.frameCount() / 1e9, scene.frameCount());
+    if (std::ranges::count(scene.exports, rend::ExportFormat::Vdb))
+        printVolumeEstimate(scene, membrane);
     return 0;
 }
 

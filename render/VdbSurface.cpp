@@ -23,20 +23,11 @@
 #include "render/AtomicFile.h"
 #include "render/ColorMap.h"
 #include "render/SplatSurface.h"
+#include "render/VdbIo.h"
 
 namespace rend::render {
 
 namespace {
-
-// io::File writes through an std::ofstream whose state it never checks, so a full disk leaves a
-// truncated .vdb. The same archive (seekable, as io::File writes it) goes into memory instead,
-// and writeFileAtomic puts it on disk with every write checked.
-class MemoryArchive : public openvdb::io::Archive {
-public:
-    void writeTo(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
-        Archive::write(out, grids, /*seekable=*/true);
-    }
-};
 
 constexpr double kDefaultVoxelFactor = 0.5;    // voxel = dx / 2
 constexpr double kDefaultRadiusFactor = 0.75;  // radius = 0.75 dx: a ~1.5 dx thick pillow
@@ -44,12 +35,6 @@ constexpr double kMinRadiusVoxels = 1.5;       // OpenVDB's default Rmin
 // The narrow band must hold the whole pillow's interior plus room for the filter's stencils.
 constexpr double kHalfWidthVoxels = 3.0;
 constexpr const char* kGridName = "surface";
-
-void initializeOpenVdb() {
-    // openvdb::initialize registers grid and metadata types for I/O; once per process.
-    static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
-}
 
 // The ParticleList contract of tools/ParticlesToLevelSet.h over a frame's positions, with one
 // radius for every particle.
@@ -69,8 +54,6 @@ public:
         getPos(n, xyz);
         radius = radius_;
     }
-    /// The attribute transferred to the voxels: the particle's index (the closest one wins).
-    void getAtt(std::size_t n, openvdb::Index32& index) const { index = openvdb::Index32(n); }
 
 private:
     std::span<const Eigen::Vector3d> positions_;
@@ -242,7 +225,6 @@ void nearestParticleColors(const sim::FrameView& frame, const RenderSettings& se
 
 struct VdbSurface::Grid {
     openvdb::FloatGrid::Ptr levelSet;
-    openvdb::FloatGrid::Ptr theta;  ///< the nearest particle's theta; null without diffusion
 };
 
 VdbSurface::VdbSurface(const sim::FrameView& rest, const VdbSettings& settings)
@@ -261,7 +243,7 @@ VdbSurface::VdbSurface(const sim::FrameView& rest, const VdbSettings& settings)
         throw std::invalid_argument("vdb surface: smoothingIterations must be >= 0");
     if (!(adaptivity_ >= 0.0 && adaptivity_ <= 1.0))
         throw std::invalid_argument("vdb surface: adaptivity must be in [0, 1]");
-    initializeOpenVdb();
+    vdb::initialize();
 }
 
 VdbSurface::~VdbSurface() = default;
@@ -270,30 +252,20 @@ VdbSurface& VdbSurface::operator=(VdbSurface&&) noexcept = default;
 
 namespace {
 
-/// The level set, and with `theta` a grid of the nearest particle's theta over its band.
-std::pair<openvdb::FloatGrid::Ptr, openvdb::FloatGrid::Ptr> rasterize(
-    std::span<const Eigen::Vector3d> positions, std::span<const double> theta, double voxel,
-    double radius, int& dropped) {
+/// The particles' spheres as a narrow-band level set.
+openvdb::FloatGrid::Ptr rasterize(std::span<const Eigen::Vector3d> positions, double voxel,
+                                  double radius, int& dropped) {
     openvdb::FloatGrid::Ptr grid =
         openvdb::createLevelSet<openvdb::FloatGrid>(voxel, kHalfWidthVoxels);
     grid->setName(kGridName);
-    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid, openvdb::Index32> raster(*grid);
+    openvdb::tools::ParticlesToLevelSet<openvdb::FloatGrid> raster(*grid);
     // The constructor already refused radii below 1.5 voxels; the slack only keeps a radius of
     // exactly 1.5 voxels from being dropped by rounding in radius / voxel.
     raster.setRmin(kMinRadiusVoxels * (1.0 - 1e-9));
     raster.rasterizeSpheres(ParticleList(positions, radius));
     raster.finalize(/*prune=*/true);
     dropped = int(raster.getMinCount() + raster.getMaxCount());
-    if (theta.empty()) return {grid, nullptr};
-    const auto nearest = raster.attributeGrid();
-    openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(0.0f);
-    values->setTransform(grid->transform().copy());
-    values->setName("theta");
-    values->setGridClass(openvdb::GRID_FOG_VOLUME);
-    auto out = values->getAccessor();
-    for (auto v = nearest->cbeginValueOn(); v; ++v)
-        if (*v < theta.size()) out.setValue(v.getCoord(), float(theta[*v]));
-    return {grid, values};
+    return grid;
 }
 
 // Mean-curvature flow moves a flat sheet's faces not at all and fills the dimples between
@@ -329,7 +301,7 @@ Mesh zeroCrossing(const openvdb::FloatGrid& grid, double adaptivity) {
 }  // namespace
 
 Mesh VdbSurface::build(const sim::FrameView& frame, const RenderSettings& settings) {
-    auto [grid, theta] = rasterize(frame.positions, frame.theta, voxelSize_, radius_, dropped_);
+    openvdb::FloatGrid::Ptr grid = rasterize(frame.positions, voxelSize_, radius_, dropped_);
     smooth(*grid, smoothingIterations_);
     Mesh mesh = zeroCrossing(*grid, adaptivity_);
     orientOutward(mesh);
@@ -338,7 +310,7 @@ Mesh VdbSurface::build(const sim::FrameView& frame, const RenderSettings& settin
     // radii find it in the first ring of cells (cells of one radius needed a second ring, 5x
     // the lookups, for most vertices).
     nearestParticleColors(frame, settings, mesh, 2.0 * radius_);
-    grid_ = std::make_unique<Grid>(Grid{std::move(grid), std::move(theta)});
+    grid_ = std::make_unique<Grid>(Grid{std::move(grid)});
     return mesh;
 }
 
@@ -346,26 +318,8 @@ std::uint64_t VdbSurface::activeVoxelCount() const {
     return grid_ ? grid_->levelSet->activeVoxelCount() : 0;
 }
 
-void VdbSurface::writeVdb(const std::filesystem::path& path) const {
-    if (!grid_) throw std::logic_error("VdbSurface::writeVdb called before build");
-    std::ostringstream bytes(std::ios::binary);
-    try {
-        // Blender and most renderers shade a fog volume named "density", not a level set: the
-        // same grid as fog (1 inside, ramping to 0 across the inner half of the narrow band).
-        openvdb::FloatGrid::Ptr density = grid_->levelSet->deepCopy();
-        openvdb::tools::sdfToFogVolume(*density);
-        density->setName("density");
-        openvdb::GridCPtrVec grids{grid_->levelSet, density};
-        if (grid_->theta) grids.push_back(grid_->theta);  // for shading by the diffusing quantity
-        MemoryArchive().writeTo(bytes, grids);
-    } catch (const std::exception& e) {
-        throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
-    }
-    writeFileAtomic(path, bytes.view());
-}
-
 VdbFileInfo inspectVdb(const std::filesystem::path& path) {
-    initializeOpenVdb();
+    vdb::initialize();
     try {
         openvdb::io::File file(path.string());
         file.open();

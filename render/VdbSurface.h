@@ -3,7 +3,8 @@
 // (tools::ParticlesToLevelSet), lightly smoothed, and meshed at the zero crossing
 // (tools::volumeToMesh). The result is a closed, watertight skin around the particles (a thin
 // "pillow" about 1.5 dx thick for a sheet) that opens wherever the particles separate.
-// OpenVDB stays out of this header: rend_render links it privately.
+// OpenVDB stays out of this header: rend_render links it privately. (`--export vdb` writes the
+// sheet at its own thickness instead: render/SheetVolume.h.)
 
 #include <array>
 #include <cstdint>
@@ -32,14 +33,8 @@ public:
     /// Rasterises the frame's particles, smooths (settings.vdb is ignored here: the surface
     /// keeps the settings it was made with), meshes the zero level set with quads split into
     /// triangles, and gives every vertex an area-weighted outward normal and the colour of its
-    /// nearest particle (particleColors). Keeps the grid for writeVdb.
+    /// nearest particle (particleColors).
     Mesh build(const sim::FrameView& frame, const RenderSettings& settings);
-
-    /// Writes the last built level set (one float grid named "surface") to `path` with
-    /// writeFileAtomic (render/AtomicFile.h): never half a file under `path`. Throws
-    /// std::logic_error before the first build, std::runtime_error (naming the path and the
-    /// reason) on failure.
-    void writeVdb(const std::filesystem::path& path) const;
 
     /// Particles OpenVDB skipped in the last build (too small or too large for the grid).
     /// The radius check in the constructor keeps this at 0; it is recorded to prove it.

@@ -51,8 +51,6 @@ def parse_args():
     p.add_argument("--motion-blur", action="store_true",
                    help="Cycles' motion blur from the velocity attribute")
     p.add_argument("--no-render", action="store_true", help="import (and save) only")
-    p.add_argument("--report", action="store_true",
-                   help="print each frame's mesh and attributes at the rendered frame")
     return p.parse_args(argv)
     return p.parse_args(argv)
 
@@ -208,10 +206,10 @@ bpy.app.handlers.frame_change_pre.append(rend_show_frame)
 
 def import_sequence(mesh_dir, material):
     """Every meshes/frame_NNNN.ply as one object, rend_sheet, whose mesh is that frame's on
-    Blender's frame NNNN. Returns the frame numbers."""
+    Blender's frame NNNN. Returns the frame numbers ([] without meshes)."""
     paths = sorted(mesh_dir.glob("frame_*.ply"))
     if not paths:
-        sys.exit(f"blender_import: no meshes/frame_*.ply in {mesh_dir}")
+        return []
     numbers = [int(path.stem.split("_")[1]) for path in paths]
     for path, number in zip(paths, numbers):
         frame_mesh(path, number).materials.append(material)
@@ -225,10 +223,11 @@ def import_sequence(mesh_dir, material):
     return numbers
 
 
-def import_volumes(vdb_dir):
+def import_volumes(vdb_dir, thickness=0.01):
     """vdb/frame_NNNN.vdb as one volume object, rend_volume, showing file NNNN on Blender's
     frame NNNN (Blender's importer would start any sequence on frame 1), shaded by its
-    density grid. Returns the frame numbers, or [] without a vdb folder."""
+    density grid, dense enough that light crossing the sheet's `thickness` (run.json's
+    vdb.thickness) is mostly stopped. Returns the frame numbers, or [] without a vdb folder."""
     paths = sorted(vdb_dir.glob("frame_*.vdb")) if vdb_dir.is_dir() else []
     if not paths:
         return []
@@ -246,7 +245,7 @@ def import_volumes(vdb_dir):
     nodes = mat.node_tree.nodes
     nodes.remove(nodes["Principled BSDF"])
     shader = nodes.new("ShaderNodeVolumePrincipled")
-    shader.inputs["Density"].default_value = 50.0
+    shader.inputs["Density"].default_value = 3.0 / thickness  # an optical depth of 3
     mat.node_tree.links.new(shader.outputs["Volume"], nodes["Material Output"].inputs["Volume"])
     volume.materials.append(mat)
     obj = bpy.data.objects.new("rend_volume", volume)
@@ -365,34 +364,6 @@ def loose_parts(mesh):
     return len({root(v) for v in used})
 
 
-def report(scene, volume):
-    """One line a test can read: what the sheet (or the volume) shows on this frame."""
-    sheet = bpy.data.objects["rend_sheet"]
-    mesh = sheet.data
-    attrs = {a.name: f"{a.domain}:{a.data_type}" for a in mesh.attributes
-             if not a.name.startswith(".")}
-    print(f"report frame={scene.frame_current} object={sheet.name} mesh={mesh.name} "
-          f"vertices={len(mesh.vertices)} faces={len(mesh.polygons)} "
-          f"loose_parts={loose_parts(mesh)} "
-          f"smooth={sum(p.use_smooth for p in mesh.polygons)} "
-          f"custom_normals={int(mesh.has_custom_normals)} "
-          f"uv={','.join(uv.name for uv in mesh.uv_layers)} "
-          f"attributes={','.join(f'{k}={v}' for k, v in sorted(attrs.items()))}")
-    if "id" in mesh.attributes:
-        ids = [d.value for d in mesh.attributes["id"].data]
-        print(f"report ids first={ids[:3]} max={max(ids)}")
-    if "velocity" in mesh.attributes:
-        v = mesh.attributes["velocity"].data[0].vector
-        print(f"report velocity0={v[0]:.6g},{v[1]:.6g},{v[2]:.6g}")
-    objects = [o.name for o in bpy.data.objects if o.type in ("MESH", "VOLUME")]
-    print(f"report objects={','.join(sorted(objects))}")
-    if "rend_volume" in bpy.data.objects:
-        grids = bpy.data.objects["rend_volume"].data.grids
-        grids.load()
-        print(f"report volume_frame={grids.frame} file={pathlib.Path(grids.frame_filepath).name} "
-              f"grids={','.join(sorted(g.name for g in grids))}")
-
-
 def main():
     args = parse_args()
     run = json.loads((args.out_dir / "run.json").read_text())
@@ -404,12 +375,17 @@ def main():
     # the resolved scene alone lacks the look's defaults.
     numbers = import_sequence(args.out_dir / "meshes",
                               vertex_colour_material(run.get("shading", render)))
-    volumes = import_volumes(args.out_dir / "vdb")
+    volumes = import_volumes(args.out_dir / "vdb", (run.get("vdb") or {}).get("thickness", 0.01))
     if args.volume and not volumes:
         sys.exit(f"blender_import: --volume, but no vdb/frame_*.vdb in {args.out_dir}")
-    bpy.data.objects["rend_sheet"].hide_render = args.volume
+    if not numbers and not args.volume:
+        sys.exit(f"blender_import: no meshes/frame_*.ply in {args.out_dir} (--export ply), "
+                 "and no --volume")
+    if numbers:
+        bpy.data.objects["rend_sheet"].hide_render = args.volume
     if volumes:
         bpy.data.objects["rend_volume"].hide_render = not args.volume
+    numbers = numbers or volumes
     add_camera(scene_json.get("camera", {}))
     add_lights(scene_json.get("light", {}), render, background)
     add_ground(render, scene_json.get("sheet", {}))
@@ -433,8 +409,6 @@ def main():
     scene.render.fps = int(scene_json.get("time", {}).get("fps", 24))
     scene.render.use_motion_blur = args.motion_blur
     scene.frame_set(args.frame)
-    if args.report:
-        report(scene, args.volume)
     if args.save:
         bpy.ops.wm.save_as_mainfile(filepath=str(args.save.resolve()))
         print(f"blender_import: saved {args.save}")
@@ -450,7 +424,7 @@ def main():
     start = time.perf_counter()
     bpy.ops.render.render(write_still=True)
     seconds = time.perf_counter() - start
-    print(f"blender_import: {len(numbers)} meshes, frame {args.frame} -> {output}")
+    print(f"blender_import: {len(numbers)} frames, frame {args.frame} -> {output}")
     print(f"render_seconds={seconds:.3f}")
     print(f"coverage={coverage(output, background):.3f}")
 

@@ -120,6 +120,11 @@ for f in meshes/frame_0006.ply meshes/frame_0006.obj meshes/frame_0006.glb vdb/f
     check "export writes $f" test -s "$tmp/export/$f"
 done
 check "exports leave no partial files" no_partial_files "$tmp/export"
+# The VDB holds the sheet at its thickness where the voxel resolves it, else two voxels.
+check "run.json gives the VDB's voxel and thickness" python3 -c "import json,sys; v=json.load(open(sys.argv[1]))['vdb']; assert v['sheet_thickness'] == 0.001 and v['thickness'] == max(0.001, 2 * v['voxel_size']) > 0, v" "$tmp/export/run.json"
+check "no VDB, no vdb entry" python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['vdb'] is None" "$tmp/ok/run.json"
+check "check estimates the VDB" run 0 check scenes/stretch.toml --set 'output.export=["vdb"]'
+check "the estimate names the voxel for the sheet's thickness" grep -q "vdb at the sheet's thickness (render.vdb_voxel_size = h / 2): voxel 0.0005 m, 0.001 m thick" "$tmp/stdout"
 check "exports keep the simulation identical" test "$(json "$tmp/export/run.json" "d['state_hash']")" = "$(json "$tmp/ok/run.json" "d['state_hash']")"
 check "bad --export refused" run 2 run scenes/stretch.toml "${small[@]}" --export ply,stl --out "$tmp/badexport"
 check "bad --export leaves no output" test ! -e "$tmp/badexport"

@@ -30,6 +30,7 @@
 #include "render/EmbreeRenderer.h"
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
+#include "render/SheetVolume.h"
 #include "render/SplatSurface.h"
 #include "render/VdbSurface.h"
 #include "sim/FrameView.h"
@@ -392,51 +393,92 @@ TEST(VdbSurface, VerticesTakeTheColourOfTheNearestParticle) {
     }
 }
 
-TEST(VdbSurface, WrittenGridReadsBackWithTheSameActiveVoxels) {
-    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
-    VdbSurface surface(frame.view(), VdbSettings{});
-    EXPECT_THROW(surface.writeVdb(scratchDir("early") / "x.vdb"), std::logic_error);
-    surface.build(frame.view(), RenderSettings{});
-    const fs::path dir = scratchDir("vdb");
-    surface.writeVdb(dir / "frame_0001.vdb");
-    const auto info = rend::render::inspectVdb(dir / "frame_0001.vdb");
-    ASSERT_EQ(info.gridCount, 2u);
-    std::map<std::string, std::uint64_t> voxels;
-    for (std::size_t k = 0; k < info.gridNames.size(); ++k)
-        voxels[info.gridNames[k]] = info.activeVoxels[k];
-    ASSERT_EQ(voxels.count("surface"), 1u) << "the level set";
-    ASSERT_EQ(voxels.count("density"), 1u) << "a fog volume Blender renders, beside it";
-    EXPECT_GT(voxels["density"], 0u);
-    EXPECT_LT(voxels["density"], voxels["surface"]) << "the inside of the narrow band";
-    EXPECT_GT(surface.activeVoxelCount(), 0u);
-    EXPECT_EQ(voxels["surface"], surface.activeVoxelCount());
-    EXPECT_NEAR(info.firstGridVoxelSize, surface.voxelSize(), 1e-12);
-    EXPECT_FALSE(anyTmpLeft(dir));
+namespace {
+
+/// Two flat squares of side `side` in z = 0, `gap` apart along x, two triangles each; vertex
+/// v stands for particle v (no Point ids).
+Mesh twoSquares(float side, float gap) {
+    Mesh mesh;
+    for (const float x0 : {-gap / 2 - side, gap / 2}) {
+        const auto base = std::uint32_t(mesh.positions.size());
+        for (const auto& [x, y] : {std::pair{0.f, 0.f}, {side, 0.f}, {side, side}, {0.f, side}})
+            mesh.positions.emplace_back(x0 + x, y - side / 2, 0.f);
+        mesh.triangles.push_back({base, base + 1, base + 2});
+        mesh.triangles.push_back({base, base + 2, base + 3});
+    }
+    return mesh;
 }
 
-// Issue 14: a sheet with a diffusing quantity writes it as a grid "theta" beside the level set
-// and the fog, each voxel holding its nearest particle's value; "density" is 1 inside.
-TEST(VdbSurface, ThetaIsWrittenAsAGridOfTheNearestParticlesValue) {
-    const Sheet frame = membraneSheet(0.3, 0.2, kDx);
-    std::vector<double> theta(std::size_t(frame.size()));
-    for (int i = 0; i < frame.size(); ++i) theta[std::size_t(i)] = 2.0 + frame.rest[i].x();
-    rend::sim::FrameView view = frame.view();
-    view.theta = theta;
-    VdbSurface surface(view, VdbSettings{});
-    surface.build(view, RenderSettings{});
-    const fs::path dir = scratchDir("vdb_theta");
-    surface.writeVdb(dir / "frame_0001.vdb");
-    const auto info = rend::render::inspectVdb(dir / "frame_0001.vdb");
-    ASSERT_EQ(info.gridNames.size(), 3u);
-    std::map<std::string, std::array<float, 2>> range;
-    for (std::size_t k = 0; k < info.gridNames.size(); ++k)
-        range[info.gridNames[k]] = info.range[k];
-    ASSERT_EQ(range.count("theta"), 1u);
-    const auto [low, high] = std::minmax_element(theta.begin(), theta.end());
-    EXPECT_NEAR(range["theta"][0], *low, 1e-6);
-    EXPECT_NEAR(range["theta"][1], *high, 1e-6);
-    EXPECT_NEAR(range["density"][1], 1.0f, 1e-6f);
-    EXPECT_GE(range["density"][0], 0.0f);
+std::map<std::string, std::size_t> gridIndex(const rend::render::VdbFileInfo& info) {
+    std::map<std::string, std::size_t> index;
+    for (std::size_t k = 0; k < info.gridNames.size(); ++k) index[info.gridNames[k]] = k;
+    return index;
+}
+
+}  // namespace
+
+// Issue 14: the exported level set is the sheet at its own thickness, not a pillow of
+// particle spheres: zero at +-h/2 about the mid-surface, -h/2 on it, positive beyond.
+TEST(SheetVolume, TheLevelSetHoldsTheSheetsThicknessWhereTheVoxelResolvesIt) {
+    using rend::render::sampleVdb;
+    const double h = 0.004, voxel = 0.001;
+    const fs::path file = scratchDir("sheet_volume") / "frame_0001.vdb";
+    const auto info = rend::render::writeSheetVolume(twoSquares(0.1f, 0.05f), {}, voxel, h, file);
+    EXPECT_DOUBLE_EQ(info.thickness, h);
+    const Eigen::Vector3d centre(-0.075, 0.0, 0.0);
+    EXPECT_NEAR(sampleVdb(file, "surface", centre), -h / 2, 0.1 * voxel);
+    for (const double side : {-1.0, 1.0}) {
+        EXPECT_NEAR(sampleVdb(file, "surface", centre + Eigen::Vector3d(0, 0, side * h / 2)), 0.0,
+                    0.1 * voxel);
+        EXPECT_NEAR(sampleVdb(file, "surface", centre + Eigen::Vector3d(0, 0, side * h)), h / 2,
+                    0.1 * voxel);
+    }
+    EXPECT_NEAR(sampleVdb(file, "density", centre), 1.0f, 1e-4f) << "Blender's fog: 1 inside";
+    EXPECT_EQ(sampleVdb(file, "density", centre + Eigen::Vector3d(0, 0, h)), 0.0f);
+    // The gap between the two pieces stays open: outside, with no fog.
+    EXPECT_GT(sampleVdb(file, "surface", Eigen::Vector3d::Zero()), 0.0f);
+    EXPECT_EQ(sampleVdb(file, "density", Eigen::Vector3d::Zero()), 0.0f);
+    const auto read = rend::render::inspectVdb(file);
+    const auto index = gridIndex(read);
+    ASSERT_EQ(read.gridCount, 2u);
+    ASSERT_EQ(index.count("surface") + index.count("density"), 2u);
+    EXPECT_EQ(read.activeVoxels[index.at("surface")], info.activeVoxels);
+    EXPECT_NEAR(read.firstGridVoxelSize, voxel, 1e-12);
+    EXPECT_FALSE(anyTmpLeft(file.parent_path()));
+}
+
+// A level set samples at voxel centres: a sheet thinner than two voxels would fall into holes,
+// so it is written two voxels thick, and says so.
+TEST(SheetVolume, ASheetThinnerThanTwoVoxelsIsWrittenTwoVoxelsThick) {
+    const double h = 0.001, voxel = 0.005;
+    EXPECT_DOUBLE_EQ(rend::render::sheetVolumeThickness(h, voxel), 2 * voxel);
+    EXPECT_DOUBLE_EQ(rend::render::sheetVolumeThickness(h, h / 2), h);
+    const fs::path file = scratchDir("sheet_volume_thin") / "frame_0001.vdb";
+    const auto info = rend::render::writeSheetVolume(twoSquares(0.2f, 0.1f), {}, voxel, h, file);
+    EXPECT_DOUBLE_EQ(info.thickness, 2 * voxel);
+    const Eigen::Vector3d centre(-0.15, 0.0, 0.0);
+    EXPECT_NEAR(rend::render::sampleVdb(file, "surface", centre), -voxel, 0.1 * voxel);
+    EXPECT_THROW(rend::render::writeSheetVolume(twoSquares(0.2f, 0.1f), {}, 0.0, h, file),
+                 std::invalid_argument);
+}
+
+// Issue 14: theta as a grid beside the shape, each voxel holding its closest triangle's
+// particles' mean, through the mesh's particle ids.
+TEST(SheetVolume, ThetaIsWrittenAsAGridOfTheClosestTrianglesParticles) {
+    Mesh mesh = twoSquares(0.1f, 0.05f);
+    mesh.points.resize(mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.points.size(); ++v)
+        mesh.points[v].id = std::int32_t(mesh.points.size() - 1 - v);  // reversed
+    const std::vector<double> theta{2, 2, 2, 2, 5, 5, 5, 5};  // particles 4-7: the left square
+    const fs::path file = scratchDir("sheet_volume_theta") / "frame_0001.vdb";
+    rend::render::writeSheetVolume(mesh, theta, 0.002, 0.004, file);
+    const auto info = rend::render::inspectVdb(file);
+    const auto index = gridIndex(info);
+    ASSERT_EQ(index.count("theta"), 1u);
+    EXPECT_NEAR(info.range[index.at("theta")][0], 2.0f, 1e-6f);
+    EXPECT_NEAR(info.range[index.at("theta")][1], 5.0f, 1e-6f);
+    EXPECT_NEAR(rend::render::sampleVdb(file, "theta", {-0.075, 0, 0}), 5.0f, 1e-5f);
+    EXPECT_NEAR(rend::render::sampleVdb(file, "theta", {0.075, 0, 0}), 2.0f, 1e-5f);
 }
 
 TEST(VdbSurface, RadiusBelowOneAndAHalfVoxelsIsRefused) {

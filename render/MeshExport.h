@@ -1,9 +1,10 @@
 #pragma once
 // Writes a render Mesh to a file another tool can open: binary PLY (point-cloud and geometry
-// tools), OBJ + MTL (everything), GLB (web viewers, Blender). GLB goes through assimp; binary
-// PLY and OBJ are written directly, because assimp 5.2's binary PLY exporter corrupts files that
-// have vertex colours (see MeshExport.cpp) and its OBJ exporter joins coincident vertices
-// (render/ObjExport.h).
+// tools), OBJ + MTL (everything), GLB (web viewers, Blender). All three are written directly,
+// not through assimp: assimp 5.2's binary PLY exporter corrupts files that have vertex colours
+// (see MeshExport.cpp), its OBJ exporter joins coincident vertices (render/ObjExport.h), and
+// its glTF exporter drops unused vertices and writes no custom attribute (render/GlbExport.h).
+// In every format vertex i is the mesh's vertex i.
 
 #include <filesystem>
 #include <string_view>
@@ -32,8 +33,7 @@ std::vector<Eigen::Vector2f> restUv(const Mesh& mesh);
 /// are encoded in memory and written with writeFileAtomic (render/AtomicFile.h) next to `path`,
 /// the main file last, so a reader never sees a half-written file nor an OBJ whose material
 /// library is missing. Returns the files written, `path` last. Throws std::system_error naming
-/// the file and the reason when a write fails, std::runtime_error with assimp's error string
-/// where assimp failed; a file that failed is not left behind.
+/// the file and the reason when a write fails; a file that failed is not left behind.
 std::vector<std::filesystem::path> exportMesh(const Mesh& mesh, const std::filesystem::path& path,
                                               MeshFormat format);
 

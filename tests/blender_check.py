@@ -108,6 +108,12 @@ def check_formats(parts):
         check(len(mesh.vertices) == len(vertices),
               f"{suffix}: {len(mesh.vertices)} vertices, as the PLY's {len(vertices)}")
         if suffix != "ply":
+            loops = numpy.zeros(len(mesh.loops), numpy.int64)
+            mesh.loops.foreach_get("vertex_index", loops)
+            uv = numpy.zeros(2 * len(mesh.loops), numpy.float32)
+            mesh.uv_layers[0].data.foreach_get("uv", uv)
+            error = numpy.abs(uv.reshape(-1, 2) - column("s", "t")[loops]).max()
+            check(error < 1e-6, f"{suffix}: the rest UV (largest difference {error:.2g})")
             smooth = sum(p.use_smooth for p in mesh.polygons)
             check(smooth == len(mesh.polygons) and mesh.has_custom_normals,
                   f"{suffix}: normals kept ({smooth} smooth faces of {len(mesh.polygons)})")

@@ -120,6 +120,14 @@ for f in meshes/frame_0006.ply meshes/frame_0006.obj meshes/frame_0006.glb vdb/f
     check "export writes $f" test -s "$tmp/export/$f"
 done
 check "exports leave no partial files" no_partial_files "$tmp/export"
+# Every format carries the same vertices in order, the same triangles and loose parts, and every
+# per-point value it can (tests/export_check.py): a torn frame, and a heated one with theta.
+check "torn foil exports" run 0 run scenes/foil_tear.toml --renderer none --export ply,obj,glb \
+    --frames 192 --out "$tmp/torn"
+check "torn frame: the same in every format, two loose parts" python3 tests/export_check.py "$tmp/torn/meshes" 192 "$(json "$tmp/torn/run.json" "d['particles']")" 2
+check "heated foil exports" run 0 run scenes/foil_tear_heat.toml --renderer none --export ply,obj,glb \
+    --frames 120 --out "$tmp/heated"
+check "heated frame: theta in the PLY and the GLB" python3 tests/export_check.py "$tmp/heated/meshes" 120 "$(json "$tmp/heated/run.json" "d['particles']")" 1 theta
 # The VDB holds the sheet at its thickness where the voxel resolves it, else two voxels.
 check "run.json gives the VDB's voxel and thickness" python3 -c "import json,sys; v=json.load(open(sys.argv[1]))['vdb']; assert v['sheet_thickness'] == 0.001 and v['thickness'] == max(0.001, 2 * v['voxel_size']) > 0, v" "$tmp/export/run.json"
 check "no VDB, no vdb entry" python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['vdb'] is None" "$tmp/ok/run.json"

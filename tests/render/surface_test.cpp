@@ -28,6 +28,7 @@
 #include "TestSupport.h"
 #include "render/ColorMap.h"
 #include "render/EmbreeRenderer.h"
+#include "render/GlbExport.h"
 #include "render/LatticeSurface.h"
 #include "render/MeshExport.h"
 #include "render/SheetVolume.h"
@@ -445,6 +446,24 @@ TEST(SheetVolume, TheLevelSetHoldsTheSheetsThicknessWhereTheVoxelResolvesIt) {
     EXPECT_EQ(read.activeVoxels[index.at("surface")], info.activeVoxels);
     EXPECT_NEAR(read.firstGridVoxelSize, voxel, 1e-12);
     EXPECT_FALSE(anyTmpLeft(file.parent_path()));
+}
+
+// A frame with no triangle left (every bond broken) still writes whole files.
+TEST(SheetVolume, AnEmptySurfaceWritesEmptyGridsAndAnEmptyGlb) {
+    const fs::path dir = scratchDir("sheet_volume_empty");
+    Mesh points;
+    points.positions = {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(1, 0, 0)};
+    const auto info = rend::render::writeSheetVolume(points, {}, 0.01, 0.001, dir / "e.vdb");
+    EXPECT_EQ(info.activeVoxels, 0u);
+    EXPECT_EQ(rend::render::inspectVdb(dir / "e.vdb").gridCount, 2u);
+    const std::string glb = rend::render::glbBytes(points);
+    std::uint32_t header[5];
+    ASSERT_GE(glb.size(), sizeof header);
+    std::memcpy(header, glb.data(), sizeof header);
+    EXPECT_EQ(header[0], 0x46546C67u) << "glTF";
+    EXPECT_EQ(header[2], glb.size());
+    EXPECT_EQ(header[3] + 20, glb.size()) << "the JSON chunk alone: no buffer without a mesh";
+    EXPECT_EQ(glb.find("\"meshes\""), std::string::npos);
 }
 
 // A level set samples at voxel centres: a sheet thinner than two voxels would fall into holes,

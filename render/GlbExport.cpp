@@ -96,17 +96,24 @@ void push(std::vector<float>& out, const Eigen::Vector3f& p) {
     out.insert(out.end(), {p.x(), p.y(), p.z()});
 }
 
+/// A position or direction, in glTF's y-up frame.
+void pushYUp(std::vector<float>& out, const Eigen::Vector3f& p) { push(out, toYUp(p)); }
+
 /// The primitive's "attributes" object, each attribute's accessor added to `buffers`.
 std::string attributes(const Mesh& mesh, Buffers& buffers) {
     const std::size_t n = mesh.positions.size();
     const std::vector<float> xyz =
-        perVertex(n, 3, [&](std::size_t v, auto& out) { push(out, mesh.positions[v]); });
+        perVertex(n, 3, [&](std::size_t v, auto& out) { pushYUp(out, mesh.positions[v]); });
     std::string a = R"("POSITION":)" + std::to_string(buffers.add(xyz, 3));
     buffers.addBounds(xyz);
-    const auto vec3 = [&](const char* name, auto get) {
+    const auto vec3 = [&](const char* name, auto get, bool direction = true) {
         a += ",\"" + std::string(name) + "\":" +
-             std::to_string(buffers.add(
-                 perVertex(n, 3, [&](std::size_t v, auto& out) { push(out, get(v)); }), 3));
+             std::to_string(buffers.add(perVertex(n, 3,
+                                                  [&](std::size_t v, auto& out) {
+                                                      direction ? pushYUp(out, get(v))
+                                                                : push(out, get(v));
+                                                  }),
+                                        3));
     };
     const auto scalar = [&](const char* name, auto get) {
         a += ",\"" + std::string(name) + "\":" +
@@ -114,7 +121,9 @@ std::string attributes(const Mesh& mesh, Buffers& buffers) {
                  perVertex(n, 1, [&](std::size_t v, auto& out) { out.push_back(get(v)); }), 1));
     };
     if (mesh.normals.size() == n) vec3("NORMAL", [&](std::size_t v) { return mesh.normals[v]; });
-    if (mesh.colors.size() == n) vec3("COLOR_0", [&](std::size_t v) { return mesh.colors[v]; });
+    if (mesh.colors.size() == n)
+        vec3(
+            "COLOR_0", [&](std::size_t v) { return mesh.colors[v]; }, /*direction=*/false);
     if (mesh.points.size() == n) {
         const std::vector<Eigen::Vector2f> uv = restUv(mesh);
         a += R"(,"TEXCOORD_0":)" +

@@ -23,6 +23,11 @@ MeshFormat parseMeshFormat(std::string_view name);
 /// The usual file extension of a format, with the dot (".ply", ".obj", ".glb").
 std::string_view meshFormatExtension(MeshFormat format);
 
+/// rend's world (z up, as Blender's) in the y-up frame of glTF (its rule) and OBJ (the
+/// convention Blender's, Maya's and Houdini's importers assume): (x, y, z) -> (x, z, -y), a
+/// rotation, so importers that convert y-up to z-up give back rend's coordinates exactly.
+inline Eigen::Vector3f toYUp(const Eigen::Vector3f& p) { return {p.x(), p.z(), -p.y()}; }
+
 /// Each vertex's rest position (Mesh::points) in [0, 1]^2 over the rest bounds of the mesh's
 /// vertices: a UV map that stays put on the sheet from frame to frame. Empty without points.
 std::vector<Eigen::Vector2f> restUv(const Mesh& mesh);

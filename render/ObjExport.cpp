@@ -40,7 +40,8 @@ std::string objText(const Mesh& mesh, const std::string& library) {
                 mesh.triangles.size() * 40);
     for (std::size_t v = 0; v < n; ++v) {
         out += 'v';
-        for (int k = 0; k < 3; ++k) appendNumber(out, mesh.positions[v][k]);
+        const Eigen::Vector3f p = toYUp(mesh.positions[v]);
+        for (int k = 0; k < 3; ++k) appendNumber(out, p[k]);
         if (colors)  // the common "v x y z r g b" extension, linear as in the mesh
             for (int k = 0; k < 3; ++k) appendNumber(out, mesh.colors[v][k]);
         out += '\n';
@@ -52,7 +53,8 @@ std::string objText(const Mesh& mesh, const std::string& library) {
     }
     for (std::size_t v = 0; normals && v < n; ++v) {
         out += "vn";
-        for (int k = 0; k < 3; ++k) appendNumber(out, mesh.normals[v][k]);
+        const Eigen::Vector3f normal = toYUp(mesh.normals[v]);
+        for (int k = 0; k < 3; ++k) appendNumber(out, normal[k]);
         out += '\n';
     }
     out += "usemtl membrane\n";

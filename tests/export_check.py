@@ -105,6 +105,11 @@ def loose_parts(n, faces):
     return len({root(v) for f in faces for v in f})
 
 
+def y_up(vectors):
+    """rend's z-up vectors in the y-up frame of the OBJ and the GLB: (x, y, z) -> (x, z, -y)."""
+    return [(x, z, -y) for x, y, z in vectors]
+
+
 def f32(x):
     return struct.unpack("f", struct.pack("f", x))[0]
 
@@ -118,22 +123,23 @@ def main():
     glb, glb_faces = read_glb(stem.with_suffix(".glb"))
     n = len(ply["x"])
     xyz = list(zip(ply["x"], ply["y"], ply["z"]))
+    normals = list(zip(ply["nx"], ply["ny"], ply["nz"]))
     check(n > particles - 1, f"{n} vertices, the {particles} particles first")
     check(ply["id"][:particles] == list(range(particles)), "PLY id: vertex i is particle i")
-    check(obj_v == xyz and obj_vn == list(zip(ply["nx"], ply["ny"], ply["nz"])),
-          "OBJ v and vn: the PLY's, in order")
+    check(obj_v == y_up(xyz) and obj_vn == y_up(normals),
+          "OBJ v and vn: the PLY's in order, y up")
     check(obj_vt == [(s, t) for s, t in zip(ply["s"], ply["t"])], "OBJ vt: the rest UV")
-    check([tuple(p) for p in glb["POSITION"]] == xyz, "GLB POSITION: the PLY's, in order")
-    check([tuple(p) for p in glb["NORMAL"]] == list(zip(ply["nx"], ply["ny"], ply["nz"])),
-          "GLB NORMAL")
+    check([tuple(p) for p in glb["POSITION"]] == y_up(xyz),
+          "GLB POSITION: the PLY's in order, y up")
+    check([tuple(p) for p in glb["NORMAL"]] == y_up(normals), "GLB NORMAL")
     check([tuple(p) for p in glb["TEXCOORD_0"]] ==
           [(s, f32(1 - t)) for s, t in zip(ply["s"], ply["t"])], "GLB TEXCOORD_0: the rest UV")
     check([int(i) for i in glb["_ID"]] == ply["id"], "GLB _ID = PLY id")
-    check([tuple(v) for v in glb["_VELOCITY"]] == list(zip(ply["vx"], ply["vy"], ply["vz"])),
-          "GLB _VELOCITY = PLY vx vy vz")
+    check([tuple(v) for v in glb["_VELOCITY"]] == y_up(zip(ply["vx"], ply["vy"], ply["vz"])),
+          "GLB _VELOCITY = PLY vx vy vz, y up")
     check(list(glb["_DAMAGE"]) == ply["damage"], "GLB _DAMAGE = PLY damage")
-    check([tuple(v) for v in glb["_REST"]] == list(zip(ply["rest_x"], ply["rest_y"],
-                                                       ply["rest_z"])), "GLB _REST = PLY rest")
+    check([tuple(v) for v in glb["_REST"]] == y_up(zip(ply["rest_x"], ply["rest_y"],
+                                                        ply["rest_z"])), "GLB _REST = PLY rest, y up")
     if sys.argv[5:6] == ["theta"]:
         check("theta" in ply and "_THETA" in glb, "theta in the PLY and the GLB")
     if "theta" in ply:

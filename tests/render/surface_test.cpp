@@ -827,7 +827,11 @@ struct Imported {
     std::map<std::pair<int, int>, aiColor4D> colors;
 };
 
-Imported importMesh(const fs::path& path) {
+/// A y-up point (glTF, OBJ) back in rend's z-up world, as Blender's importers turn it.
+aiVector3D fromYUp(const aiVector3D& p) { return {p.x, -p.z, p.y}; }
+
+/// `yUp`: the file is in the y-up frame (MeshExport.h toYUp); its points are turned back.
+Imported importMesh(const fs::path& path, bool yUp = false) {
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(path.string(), aiProcess_JoinIdenticalVertices);
     Imported out;
@@ -840,7 +844,7 @@ Imported importMesh(const fs::path& path) {
         out.vertices += mesh.mNumVertices;
         out.faces += mesh.mNumFaces;
         for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-            const aiVector3D& p = mesh.mVertices[v];
+            const aiVector3D p = yUp ? fromYUp(mesh.mVertices[v]) : mesh.mVertices[v];
             out.min = aiVector3D(std::min(out.min.x, p.x), std::min(out.min.y, p.y),
                                  std::min(out.min.z, p.z));
             out.max = aiVector3D(std::max(out.max.x, p.x), std::max(out.max.y, p.y),
@@ -876,7 +880,7 @@ TEST(MeshExport, EveryFormatRoundTripsThroughAssimp) {
         if (format == MeshFormat::Obj) {
             EXPECT_TRUE(fs::exists(dir / "frame_0001.mtl"));
         }
-        const Imported back = importMesh(path);
+        const Imported back = importMesh(path, format != MeshFormat::Ply);
         EXPECT_EQ(back.faces, mesh.triangles.size());
         EXPECT_EQ(back.vertices, mesh.positions.size());
         EXPECT_NEAR(back.min.x, 0.0f, 1e-6f);
@@ -1105,7 +1109,7 @@ TEST(MeshExport, ExportsCarryTheParticlesIdsVelocitiesAndRestPositions) {
         }
         for (unsigned v = 0; format == MeshFormat::Glb && v < m.mNumVertices; ++v)
             ASSERT_LT((Eigen::Vector3f(m.mVertices[v].x, m.mVertices[v].y, m.mVertices[v].z) -
-                       mesh.positions[v])
+                       rend::render::toYUp(mesh.positions[v]))
                           .norm(),
                       1e-5f)
                 << path << " vertex " << v;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -65,6 +66,17 @@ private:
     std::map<std::array<double, 3>, int> ids_;
 };
 
+/// glTF is y up by rule and OBJ by convention (Blender, Maya and Houdini write and read it so):
+/// such files are turned into rend's z-up world, (x, y, z) -> (x, -z, y), the inverse of
+/// MeshExport.h's toYUp. Other formats (PLY, STL) are taken as they are, as Blender does.
+aiMatrix4x4 worldFrame(const std::filesystem::path& file) {
+    std::string extension = file.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (extension != ".obj" && extension != ".gltf" && extension != ".glb") return {};
+    return aiMatrix4x4(1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1);
+}
+
 }  // namespace
 
 sim::TriangleMesh importTriangleMesh(const std::filesystem::path& file, double scale) {
@@ -80,7 +92,7 @@ sim::TriangleMesh importTriangleMesh(const std::filesystem::path& file, double s
         throw importError(file,
                           std::string("assimp cannot read it (") + importer.GetErrorString() + ")");
     MeshBuilder builder(scale);
-    builder.addNode(*scene, *scene->mRootNode, aiMatrix4x4());
+    builder.addNode(*scene, *scene->mRootNode, worldFrame(file));
     sim::TriangleMesh mesh = builder.take();
     if (mesh.triangles.empty()) throw importError(file, "the file holds no triangles");
     return mesh;

@@ -10,7 +10,9 @@
 namespace rend::render {
 
 /// Every triangle of every mesh in `file`, node transforms applied, joined into one mesh and
-/// multiplied by `scale`. The collider needs positions only, so vertices at the same position
+/// multiplied by `scale`. OBJ, glTF and GLB are y up and are turned into rend's z-up world
+/// ((x, y, z) -> (x, -z, y), as Blender's importers do); PLY and other formats are taken as
+/// they are. The collider needs positions only, so vertices at the same position
 /// are one vertex even where the file splits them by normal or texture coordinate (a cube's
 /// corners in an OBJ with `vn` lines), and triangles that this leaves degenerate are dropped.
 /// Polygons are triangulated; points and lines are ignored. Throws std::runtime_error naming the

@@ -248,15 +248,39 @@ TEST(MeshImport, ReadsAnObjCubeAsEightVerticesAndTwelveTrianglesScaled) {
     ASSERT_EQ(mesh.triangles.size(), 12u);
     EXPECT_EQ(openEdgeCount(mesh), 0u);
     EXPECT_TRUE(rend::render::isClosed(mesh));
-    for (const Vec3& v : mesh.vertices)  // every corner scaled to 0 or 2
-        for (int k = 0; k < 3; ++k) EXPECT_TRUE(v[k] == 0.0 || v[k] == 2.0) << v.transpose();
+    // Every corner scaled to 0 or 2, and turned from the OBJ's y up: its y is -z here.
+    for (const Vec3& v : mesh.vertices)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_TRUE(v[k] == 0.0 || v[k] == (k == 1 ? -2.0 : 2.0)) << v.transpose();
     // The winding survives: every face turns away from the cube's centre.
-    const Vec3 centre(1.0, 1.0, 1.0);
+    const Vec3 centre(1.0, -1.0, 1.0);
     for (const auto& t : mesh.triangles) {
         const Vec3& a = mesh.vertices[t[0]];
         const Vec3 n = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a);
         EXPECT_GT(n.dot(a - centre), 0.0);
     }
+}
+
+// A post 3 tall along the file's y: upright in rend's z-up world from an OBJ (y up, as
+// Blender writes it), along y from a PLY (taken as it is, as Blender reads it).
+TEST(MeshImport, AYUpObjStandsUpAndAPlyIsTakenAsItIs) {
+    const auto bounds = [](const TriangleMesh& mesh) {
+        Vec3 low = Vec3::Constant(1e30), high = -low;
+        for (const Vec3& v : mesh.vertices) low = low.cwiseMin(v), high = high.cwiseMax(v);
+        return Eigen::Vector3d(high - low);
+    };
+    std::string obj, ply =
+                         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                         "property float y\nproperty float z\nelement face 2\n"
+                         "property list uchar int vertex_indices\nend_header\n";
+    for (const char* v : {"0 0 0", "1 0 0", "1 3 0", "0 3 0"}) {
+        obj += std::string("v ") + v + "\n";
+        ply += std::string(v) + "\n";
+    }
+    obj += "f 1 2 3\nf 1 3 4\n";
+    ply += "3 0 1 2\n3 0 2 3\n";
+    EXPECT_TRUE(bounds(importTriangleMesh(writeFile("post.obj", obj))).isApprox(Vec3(1, 0, 3)));
+    EXPECT_TRUE(bounds(importTriangleMesh(writeFile("post.ply", ply))).isApprox(Vec3(1, 3, 0)));
 }
 
 TEST(MeshImport, CountsTheRimOfAnOpenMesh) {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "app/ContactLoader.h"
+#include "app/MaterialMapLoader.h"
 #include "app/Scene.h"
 #include "app/SceneDocument.h"
 #include "app/SceneError.h"
@@ -708,6 +709,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     s.overrides = overrides;
     readSheet(root, s);
     s.sim.material = readMaterial(root);
+    readMaterialMaps(root, s);
     s.sim.boundaries = readBoundaries(root, s);
     s.sim.notches = readNotches(root, s.sim.sheet);
     s.sim.diffusion = readDiffusion(root, s);

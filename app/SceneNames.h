@@ -18,6 +18,10 @@ inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
 inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper", "preview",
                                                           "midway"};
+inline constexpr std::string_view kMappedProperties[] = {"E", "fracture_energy",
+                                                         "density"};  // sim::MappedProperty
+inline constexpr std::string_view kMapShapes[] = {"box", "disc", "polygon", "noise",
+                                                  "image"};  // sim::MapShape
 inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};
 inline constexpr std::string_view kEdges[] = {"left", "right", "bottom", "top"};
 inline constexpr std::string_view kIntegrators[] = {"symplectic_euler", "velocity_verlet"};

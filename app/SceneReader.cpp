@@ -194,6 +194,10 @@ const Section& sectionAt(std::string_view path) {
 std::size_t KeyLog::visit(const toml::table& table, const Section& section, std::string path,
                           std::string title, std::string location) {
     locations_.emplace(path, std::move(location));
+    // A table read by two readers ([material]'s keys and its [[material.map]]) is one entry,
+    // so neither reports the other's keys as unused.
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+        if (entries_[k].table == &table && entries_[k].path == path) return k;
     entries_.push_back({&table, &section, std::move(path), std::move(title), {}});
     return entries_.size() - 1;
 }

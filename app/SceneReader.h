@@ -114,7 +114,7 @@ std::string schemaMarkdown();
 /// schema.
 class KeyLog {
 public:
-    /// Returns the index of the table's entry.
+    /// Returns the index of the table's entry (the same for a table visited again).
     std::size_t visit(const toml::table& table, const Section& section, std::string path,
                       std::string title, std::string location);
     void use(std::size_t entry, std::string_view key, const toml::node& value);

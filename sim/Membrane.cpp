@@ -27,7 +27,9 @@ Membrane::Membrane(const MembraneParams& given)
     if (!lattice_.areas.empty())
         for (int i = 0; i < n; ++i) volume_[i] = lattice_.areas[i] * sheet.thickness;
     mass_.resize(n);
-    for (int i = 0; i < n; ++i) mass_[i] = params.material.density * volume_[i];
+    const std::vector<double> density =
+        materialFactors(MappedProperty::Density, params.materialMaps, x0_);
+    for (int i = 0; i < n; ++i) mass_[i] = params.material.density * density[i] * volume_[i];
     bonds_ = buildBondFamilies(x0_, horizon_);
     damageState_ = DamageState(bonds_, lattice_.triangles);
     const Material material(params.material);  // validated once, for every solver

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/Collider.h"
+#include "sim/MaterialMap.h"
 
 namespace rend::sim {
 
@@ -193,7 +194,8 @@ struct MembraneParams {
     TimeParams time;
     std::vector<Notch> notches;
     DiffusionParams diffusion;
-    ContactParams contact;  ///< ground, colliders, self-contact (sim/Contact.h)
+    ContactParams contact;                  ///< ground, colliders, self-contact (sim/Contact.h)
+    std::vector<MaterialMap> materialMaps;  ///< E, G_f and density over the sheet
 };
 
 }  // namespace rend::sim

@@ -22,6 +22,7 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
       horizon_(params.sheet.horizonFactor * params.sheet.dx) {
     computeBondScales(params, lattice.particleArea);
     setUpFracture(params.material);
+    setUpStretchMap(params.materialMaps);
 }
 
 std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
@@ -45,6 +46,7 @@ void PeridynamicBonds::computeBondScales(const MembraneParams& params, double pa
         throw std::invalid_argument(
             "no particle has a bond with non-zero weight: raise the horizon");
     if (params.material.surfaceCorrection) applySurfaceCorrection();
+    applyStiffnessMap(params.materialMaps);
     const MaterialParams& m = params.material;
     const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
                            : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
@@ -105,6 +107,32 @@ void PeridynamicBonds::applySurfaceCorrection() {
         }
 }
 
+/// A bond's stiffness is the mean of its ends' E (issue 15's material maps).
+void PeridynamicBonds::applyStiffnessMap(std::span<const MaterialMap> maps) {
+    if (!mapsProperty(maps, MappedProperty::YoungsModulus)) return;
+    const std::vector<double> e = materialFactors(MappedProperty::YoungsModulus, maps, rest_);
+    for (int i = 0; i < bonds_.particleCount(); ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            bondScale_[b] *= 0.5 * (e[i] + e[bonds_.partners[b]]);
+}
+
+/// A bond's critical stretch goes as sqrt(G_f / E) (eq. 28 and its calibrated form), with the
+/// means of its ends' factors; empty when no map changes either.
+void PeridynamicBonds::setUpStretchMap(std::span<const MaterialMap> maps) {
+    stretchFactor_.clear();
+    if (!std::isfinite(criticalStretch_) || (!mapsProperty(maps, MappedProperty::YoungsModulus) &&
+                                             !mapsProperty(maps, MappedProperty::FractureEnergy)))
+        return;
+    const std::vector<double> e = materialFactors(MappedProperty::YoungsModulus, maps, rest_);
+    const std::vector<double> g = materialFactors(MappedProperty::FractureEnergy, maps, rest_);
+    stretchFactor_.resize(bonds_.directedCount());
+    for (int i = 0; i < bonds_.particleCount(); ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int j = bonds_.partners[b];
+            stretchFactor_[b] = std::sqrt((g[i] + g[j]) / (e[i] + e[j]));
+        }
+}
+
 void PeridynamicBonds::setUpFracture(const MaterialParams& m) {
     criticalStretch_ = std::numeric_limits<double>::infinity();
     if (m.fractureEnergy) {
@@ -147,6 +175,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const int* partners = bonds_.partners.data();
     const double* restLength = bonds_.restLength.data();
     const double* bondScale = bondScale_.data();
+    const double* stretchFactor = stretchFactor_.empty() ? nullptr : stretchFactor_.data();
     const std::uint8_t* alive = damage_->bondAlive().data();
     std::uint8_t* proposed = updates.proposed;
     PlasticState* plastic = updates.plastic;
@@ -176,6 +205,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
             }
             if constexpr (kBreak) {  // eq. 27/28
                 double limit = criticalStretch_;
+                if (stretchFactor) limit *= stretchFactor[b];
                 if constexpr (kTheta) limit *= material_.strengthFactor(thetaBar);
                 if (eta > limit) {
                     if constexpr (kUpdateBonds) proposed[b] = 1, ++breaking;

@@ -55,6 +55,8 @@ private:
     void computeBondScales(const MembraneParams& params, double particleArea);
     void applySurfaceCorrection();
     void setUpFracture(const MaterialParams& m);
+    void applyStiffnessMap(std::span<const MaterialMap> maps);
+    void setUpStretchMap(std::span<const MaterialMap> maps);
     /// What the force loop may change: with kUpdateBonds (advance()) the plastic history and
     /// the proposed breaks, through these pointers; otherwise nothing.
     struct Updates {
@@ -82,6 +84,7 @@ private:
     BondLaw law_;
     double criticalStretch_ = 0.0;
     std::vector<double> bondScale_;      ///< force on i per unit of f(eta), see BondLaw.h
+    std::vector<double> stretchFactor_;  ///< per bond, from material maps; empty: all 1
     std::vector<PlasticState> plastic_;  ///< per bond; empty unless the law is elastoplastic
     double stiffening_ = 1.0;            ///< the most compressed bond's, over c (advance() only)
 };

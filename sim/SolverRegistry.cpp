@@ -14,36 +14,36 @@ namespace rend::sim {
 namespace {
 
 // One line per solver. SolverSupport: {bondLaws, fracture, sphere, paperCriticalStretch,
-// surfaceCorrection}.
+// surfaceCorrection, materialMaps}.
 constexpr std::array kSolvers{
     SolverEntry{"peridynamic",
                 "bond forces (eqs. 18-20), fracture, diffusion coupling",
                 "membrane paper",
-                {true, true, true, true, true},
+                {true, true, true, true, true, true},
                 &PeridynamicBonds::make},
     SolverEntry{"fem_cst",
                 "constant-strain triangles, St. Venant-Kirchhoff in plane stress (the exact "
                 "gradient of the energy); the power law and elastoplastic law on the principal "
                 "stretches",
                 "seminar report",
-                {true, true, true, false, false},
+                {true, true, true, false, false, false},
                 &FemCst::make},
     SolverEntry{"mass_spring_vg",
                 "one spring per triangle edge, Van Gelder's k (eq. 1)",
                 "mass-spring paper",
-                {true, true, true, false, false},
+                {true, true, true, false, false, false},
                 &MassSpring::makeVanGelder},
     SolverEntry{"mass_spring_tp",
                 "two-parameter springs: fixed Q (eq. 12) x variable q (eq. 14), from the sides' "
                 "and heights' strains",
                 "mass-spring paper",
-                {true, true, true, false, false},
+                {true, true, true, false, false, false},
                 &MassSpring::makeTwoParameter},
     SolverEntry{"sph",
                 "kernel-corrected total-Lagrangian SPH (rest neighbours within 2 dx), St. "
                 "Venant-Kirchhoff as the FEM; fracture by damage-weighted pairs",
                 "membrane paper, Sec. 6.1",
-                {false, true, false, false, false},
+                {false, true, false, false, false, false},
                 &TotalLagrangianSph::make},
 };
 
@@ -90,6 +90,9 @@ std::string unsupportedFeatures(const SolverEntry& solver, const MembraneParams&
     if (params.sheet.outline == Outline::Sphere && !can.sphere)
         wanted.push_back("shape = \"sphere\"");
     if (m.surfaceCorrection && !can.surfaceCorrection) wanted.push_back("surface_correction");
+    if (!can.materialMaps && (mapsProperty(params.materialMaps, MappedProperty::YoungsModulus) ||
+                              mapsProperty(params.materialMaps, MappedProperty::FractureEnergy)))
+        wanted.push_back("a material map of E or fracture_energy");
     return joined(wanted, " and ");
 }
 
@@ -108,6 +111,7 @@ std::string solverTableMarkdown() {
         if (can.bondLaws) takes.push_back("bond laws");
         if (can.fracture) takes.push_back("fracture");
         if (can.sphere) takes.push_back("sphere");
+        if (can.materialMaps) takes.push_back("material maps");
         if (can.paperCriticalStretch) takes.push_back("`critical_stretch = \"paper\"`");
         if (can.surfaceCorrection) takes.push_back("`surface_correction`");
         out += "| `" + std::string(e.name) + "` | " + std::string(e.model) + " | " +

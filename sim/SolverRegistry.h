@@ -25,6 +25,7 @@ struct SolverSupport {
     bool sphere = false;                ///< shape = "sphere": a closed, curved rest sheet
     bool paperCriticalStretch = false;  ///< critical_stretch = "paper" (eq. 28 as printed)
     bool surfaceCorrection = false;     ///< surface_correction = true
+    bool materialMaps = false;          ///< maps of E and fracture_energy (density: every one)
 };
 
 /// What a factory builds a solver from: the scene, its validated material, the rest lattice,

@@ -10,6 +10,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "tests/ScratchDir.h"
+#include "tests/app/Refusal.h"
 
 using namespace rend;
 namespace fs = std::filesystem;
@@ -34,21 +35,10 @@ fs::path writeScene(const std::string& text) {
     return file;
 }
 
-/// The message loading `text` fails with ("" when it loads).
-std::string refusal(const std::string& text) {
-    try {
-        loadScene(writeScene(text));
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
+std::string refusal(const std::string& text) { return test::refusalOf(writeScene(text)); }
 
 void expectRefused(const std::string& text, int line, const std::string& fragment) {
-    const std::string message = refusal(text);
-    EXPECT_NE(message.find("scene.toml:" + std::to_string(line) + ":"), std::string::npos)
-        << message;
-    EXPECT_NE(message.find(fragment), std::string::npos) << message;
+    test::expectRefusedAt(refusal(text), line, fragment);
 }
 
 }  // namespace

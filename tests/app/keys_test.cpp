@@ -92,6 +92,17 @@ const std::pair<std::string, std::string> kDisc = {"size = [0.2, 0.2]",
 std::pair<std::string, std::string> collider(const std::string& shape) {
     return {"[time]", "[[collider]]\n" + shape + "\n\n[time]"};
 }
+/// A material map before [time]; `keys` gives its keys.
+std::pair<std::string, std::string> map(const std::string& keys) {
+    return {"[time]", "[[material.map]]\nproperty = \"E\"\n" + keys + "\n\n[time]"};
+}
+const std::string kMapBox = "shape = \"box\"\nmin = [-0.1, -0.1]\nmax = [0.0, 0.1]\nfactor = 0.5";
+const std::string kMapDisc = "shape = \"disc\"\ncenter = [0.0, 0.0]\nradius = 0.05\nfactor = 0.5";
+const std::string kMapPolygon =
+    "shape = \"polygon\"\npoints = [[-0.1, -0.1], [0.1, -0.1], [0.0, 0.1]]\nfactor = 0.5";
+const std::string kMapNoise = "shape = \"noise\"\nscale = [0.05, 0.05]";
+const std::string kMapImage =
+    "shape = \"image\"\nfile = \"" REND_SOURCE_DIR "/tests/data/map_gradient.png\"";
 const std::string kSphere = "shape = \"sphere\"\nradius = 0.05\nposition = [0.0, 0.0, -0.052]";
 const std::string kBox = "shape = \"box\"\nsize = [0.1, 0.1, 0.1]\nposition = [0.0, 0.0, -0.052]";
 const std::string kCube = "shape = \"mesh\"\nfile = \"" REND_SOURCE_DIR
@@ -190,6 +201,31 @@ std::vector<Variation> variations() {
          {},
          collider(kSphere)},
         {"collider[].radius", {"collider.0.radius=0.06"}, {}, collider(kSphere)},
+        {"material.map[].property", {"material.map.0.property=density"}, {}, map(kMapBox)},
+        {"material.map[].shape",
+         {"material.map.0.shape=box", "material.map.0.min=[-0.1, -0.1]",
+          "material.map.0.max=[0.0, 0.1]", "material.map.0.factor=0.5"},
+         {},
+         map("shape = \"noise\"")},
+        {"material.map[].factor", {"material.map.0.factor=0.3"}, {}, map(kMapBox)},
+        {"material.map[].min", {"material.map.0.min=[-0.1, -0.05]"}, {}, map(kMapBox)},
+        {"material.map[].max", {"material.map.0.max=[0.05, 0.1]"}, {}, map(kMapBox)},
+        {"material.map[].center", {"material.map.0.center=[0.05, 0.0]"}, {}, map(kMapDisc)},
+        {"material.map[].radius", {"material.map.0.radius=0.08"}, {}, map(kMapDisc)},
+        {"material.map[].points",
+         {"material.map.0.points=[[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1]]"},
+         {},
+         map(kMapPolygon)},
+        {"material.map[].scale", {"material.map.0.scale=[0.1, 0.02]"}, {}, map(kMapNoise)},
+        {"material.map[].amplitude", {"material.map.0.amplitude=0.8"}, {}, map(kMapNoise)},
+        {"material.map[].octaves", {"material.map.0.octaves=2"}, {}, map(kMapNoise)},
+        {"material.map[].seed", {"material.map.0.seed=5"}, {}, map(kMapNoise)},
+        {"material.map[].file",
+         {"material.map.0.file=\"" REND_SOURCE_DIR "/tests/data/map_stripes.png\""},
+         {},
+         map(kMapImage)},
+        {"material.map[].low", {"material.map.0.low=0.2"}, {}, map(kMapImage)},
+        {"material.map[].high", {"material.map.0.high=3.0"}, {}, map(kMapImage)},
         {"collider[].size", {"collider.0.size=[0.1, 0.1, 0.11]"}, {}, collider(kBox)},
         {"collider[].length",
          {"collider.0.length=0.2"},

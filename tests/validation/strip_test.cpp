@@ -45,3 +45,20 @@ TEST(ValidationStrip, SurfaceCorrectionKeepsTheInteriorAndTheStableTimeStepClose
     EXPECT_LE(corrected.stableTimeStep(), plain.stableTimeStep() * (1 + 1e-12));
     EXPECT_DOUBLE_EQ(rend::test::micromodulus(corrected), rend::test::micromodulus(plain));
 }
+
+// Issue 15, seed 002's kind of experiment: a stiff and a soft half pulled together. In series
+// both carry one stress, so each half's strain is that stress over its own E (the closed form
+// of the displacement: piecewise linear with those slopes). The E map must give each half its
+// modulus; VALIDATION.md's 2%.
+TEST(ValidationBimaterial, EachHalfOfAStiffAndSoftStripStrainsAsItsOwnModulusWithinTwoPercent) {
+    for (const double ratio : {0.25, 0.5, 4.0}) {
+        const BimaterialFigures f = bimaterialStrip(ratio);
+        std::printf(
+            "bimaterial strip, x > 0 at %.2f E: measured E / E %.4f (x < 0), %.4f (x > 0)\n", ratio,
+            f.stiff, f.soft);
+        EXPECT_NEAR(f.stiff, 1.0, 0.02) << ratio;
+        EXPECT_NEAR(f.soft, 1.0, 0.02) << ratio;
+    }
+    const BimaterialFigures same = bimaterialStrip(1.0);
+    EXPECT_NEAR(same.stiff, same.soft, 1e-3) << "a factor of 1 changes nothing";
+}

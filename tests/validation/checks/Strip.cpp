@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 namespace rend::checks {
@@ -86,15 +87,24 @@ MembraneParams stripParams(const Strip& s) {
     return p;
 }
 
-double stripModulus(const Strip& s) {
-    const MembraneParams params = stripParams(s);
-    Membrane m(params);
+namespace {
+
+/// The strip relaxed under its grips: displacements, the far grip's reaction, and where it lies.
+struct StripSolution {
+    std::unique_ptr<Membrane> m;
+    std::vector<double> u;
+    double reaction = 0.0, lo = 1e9, hi = -1e9;
+    int axis = 0;
+};
+
+StripSolution solveStrip(const Strip& s, const MembraneParams& params) {
+    StripSolution out{std::make_unique<Membrane>(params)};
+    Membrane& m = *out.m;
     const int n = m.particleCount();
-    const int axis = s.alongX ? 0 : 1;
-    double lo = 1e9, hi = -1e9, across = 0.0;
+    const int axis = out.axis = s.alongX ? 0 : 1;
     for (const auto& x : m.restPositions()) {
-        lo = std::min(lo, x[axis]);
-        hi = std::max(hi, x[axis]);
+        out.lo = std::min(out.lo, x[axis]);
+        out.hi = std::max(out.hi, x[axis]);
     }
     const double grip = std::max(m.horizon(), 2 * params.sheet.dx) + 1e-9;
     std::vector<bool> fixed(2 * n, false);
@@ -102,7 +112,7 @@ double stripModulus(const Strip& s) {
     int centre = 0;
     for (int i = 0; i < n; ++i) {
         const Eigen::Vector3d& x = m.restPositions()[i];
-        if (x[axis] < lo + grip || x[axis] > hi - grip) {
+        if (x[axis] < out.lo + grip || x[axis] > out.hi - grip) {
             fixed[2 * i + axis] = true;
             u[2 * i + axis] = kStrain * x[axis];
         }
@@ -110,35 +120,70 @@ double stripModulus(const Strip& s) {
     }
     fixed[2 * centre + 1 - axis] = true;  // no rigid sliding across the strip
     const Stiffness K(m, fixed);
-    u = relax(K, u);
-
-    // Reaction on the far grip, and the strain of the middle half by least squares.
+    out.u = relax(K, u);
     std::vector<Eigen::Vector3d> f;
     for (int i = 0; i < n; ++i) {
         m.positions()[i] = m.restPositions()[i];
-        m.positions()[i].x() += u[2 * i];
-        m.positions()[i].y() += u[2 * i + 1];
+        m.positions()[i].x() += out.u[2 * i];
+        m.positions()[i].y() += out.u[2 * i + 1];
     }
     m.computeForces(f);
-    double reaction = 0.0, sx = 0, sy = 0, sxx = 0, sxy = 0, count = 0;
-    const double mid = 0.5 * (lo + hi), quarter = 0.25 * (hi - lo);
-    for (int i = 0; i < n; ++i) {
-        const double x = m.restPositions()[i][axis];
-        if (x > hi - grip) reaction -= f[i][axis];
-        if (std::abs(x - mid) < quarter) {
-            const double v = u[2 * i + axis];
-            sx += x, sy += v, sxx += x * x, sxy += x * v, count += 1;
-        }
+    for (int i = 0; i < n; ++i)
+        if (m.restPositions()[i][axis] > out.hi - grip) out.reaction -= f[i][axis];
+    return out;
+}
+
+/// The strain along the strip fitted by least squares over [from, to] of the rest axis.
+double fittedStrain(const StripSolution& s, double from, double to) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, count = 0;
+    for (int i = 0; i < s.m->particleCount(); ++i) {
+        const double x = s.m->restPositions()[i][s.axis];
+        if (x < from || x > to) continue;
+        const double v = s.u[2 * i + s.axis];
+        sx += x, sy += v, sxx += x * x, sxy += x * v, count += 1;
     }
-    const double strainMid = (count * sxy - sx * sy) / (count * sxx - sx * sx);
-    // Cells per unit length over whole lattice periods (dx along x; two rows along y).
+    return (count * sxy - sx * sy) / (count * sxx - sx * sx);
+}
+
+/// The strip's cross-section h W, W counted in cells over whole lattice periods (dx along x;
+/// two rows along y).
+double crossSection(const Strip& s, const MembraneParams& params, const StripSolution& sol) {
     const double period = s.alongX ? params.sheet.dx : params.sheet.dx * std::sqrt(3.0);
-    const int periods = int((hi - lo) / period);
+    const int periods = int((sol.hi - sol.lo) / period);
     int inside = 0;
-    for (const auto& x : m.restPositions())
-        if (x[axis] < lo + periods * period - 1e-9 * period) ++inside;
-    across = inside * params.sheet.dx * params.sheet.dx * std::sqrt(3.0) / 2 / (periods * period);
-    return reaction / (params.sheet.thickness * across * strainMid) / kE;
+    for (const auto& x : sol.m->restPositions())
+        if (x[sol.axis] < sol.lo + periods * period - 1e-9 * period) ++inside;
+    return params.sheet.thickness * inside * params.sheet.dx * params.sheet.dx * std::sqrt(3.0) /
+           2 / (periods * period);
+}
+
+}  // namespace
+
+double stripModulus(const Strip& s) {
+    const MembraneParams params = stripParams(s);
+    const StripSolution sol = solveStrip(s, params);
+    const double mid = 0.5 * (sol.lo + sol.hi), quarter = 0.25 * (sol.hi - sol.lo);
+    const double strainMid = fittedStrain(sol, mid - quarter, mid + quarter);
+    return sol.reaction / (crossSection(s, params, sol) * strainMid) / kE;
+}
+
+BimaterialFigures bimaterialStrip(double softFactor) {
+    const Strip s{true, 20, 1.5, true};
+    MembraneParams params = stripParams(s);
+    MaterialMap soft;
+    soft.property = MappedProperty::YoungsModulus;
+    soft.shape = MapShape::Box;
+    soft.min = {0.0, -1e3};
+    soft.max = {1e3, 1e3};
+    soft.factor = softFactor;
+    params.materialMaps = {soft};
+    const StripSolution sol = solveStrip(s, params);
+    // Each half's strain away from its grip and from the interface (x = 0).
+    const double half = 0.5 * (sol.hi - sol.lo), margin = 0.25 * half;
+    const double stiff = fittedStrain(sol, sol.lo + margin, -margin);
+    const double weak = fittedStrain(sol, margin, sol.hi - margin);
+    const double stress = sol.reaction / crossSection(s, params, sol);
+    return {stress / stiff / kE, stress / weak / (softFactor * kE)};
 }
 
 SkinFigures skin(bool alongX, double horizonFactor, bool corrected) {

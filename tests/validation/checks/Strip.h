@@ -39,4 +39,14 @@ struct SkinFigures {
 
 SkinFigures skin(bool alongX, double horizonFactor, bool corrected);
 
+/// Issue 15's bimaterial strip: the surface-corrected strip (20 cells, R = 1.5 dx) with an E
+/// map making its half x > 0 `softFactor` times as stiff, pulled by its grips. In series both
+/// halves carry the same stress, so each half's strain is stress / its E (the closed form):
+/// the figures are each half's measured modulus over its own, 1 when the map is exact.
+struct BimaterialFigures {
+    double stiff;  ///< E measured in x < 0 over E
+    double soft;   ///< E measured in x > 0 over softFactor E
+};
+BimaterialFigures bimaterialStrip(double softFactor);
+
 }  // namespace rend::checks

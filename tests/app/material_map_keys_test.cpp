@@ -1,0 +1,140 @@
+// [[material.map]] as a hostile user writes it: every mistake refused at its file:line:column
+// with what was expected; good maps load into the simulation's parameters.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "app/Scene.h"
+#include "app/SceneError.h"
+#include "render/Image.h"
+#include "tests/ScratchDir.h"
+#include "tests/app/Refusal.h"
+
+using namespace rend;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kSheet = R"([sheet]
+size = [0.4, 0.4]
+dx = 0.02
+
+[material]
+E = 2e4
+density = 5000
+fracture_energy = 1.0
+
+)";  // the map text starts on line 10
+
+fs::path writeScene(const std::string& text) {
+    const fs::path file = test::scratchDir() / "scene.toml";
+    std::ofstream(file) << kSheet << text;
+    return file;
+}
+
+std::string refusal(const std::string& text, const std::vector<std::string>& sets = {}) {
+    return test::refusalOf(writeScene(text), sets);
+}
+
+void expectRefused(const std::string& text, int line, const std::string& fragment) {
+    test::expectRefusedAt(refusal(text), line, fragment);
+}
+
+}  // namespace
+
+TEST(MaterialMapKeys, EveryShapeLoads) {
+    render::Image grey{2, 1, {0, 0, 0, 255, 255, 255}};
+    render::writePngAtomic(grey, test::scratchDir() / "fibres.png");
+    const Scene s = loadScene(writeScene(R"([[material.map]]
+property = "E"
+shape = "box"
+min = [-0.2, -0.2]
+max = [0.0, 0.2]
+factor = 0.5
+
+[[material.map]]
+property = "density"
+shape = "disc"
+center = [0.1, 0.1]
+radius = 0.05
+factor = 2.0
+
+[[material.map]]
+property = "fracture_energy"
+shape = "noise"
+scale = [0.2, 0.02]
+amplitude = 0.6
+octaves = 3
+seed = 9
+
+[[material.map]]
+property = "E"
+shape = "image"
+file = "fibres.png"
+low = 0.8
+high = 1.2
+)"));
+    const auto& maps = s.sim.materialMaps;
+    ASSERT_EQ(maps.size(), 4u);
+    EXPECT_EQ(maps[0].shape, sim::MapShape::Box);
+    EXPECT_EQ(maps[0].factor, 0.5);
+    EXPECT_EQ(maps[1].property, sim::MappedProperty::Density);
+    EXPECT_EQ(maps[1].radius, 0.05);
+    EXPECT_EQ(maps[2].property, sim::MappedProperty::FractureEnergy);
+    EXPECT_EQ(maps[2].scale, Eigen::Vector2d(0.2, 0.02));
+    EXPECT_EQ(maps[2].octaves, 3);
+    EXPECT_EQ(maps[2].seed, 9u);
+    EXPECT_EQ(maps[3].image.width, 2);
+    EXPECT_FLOAT_EQ(maps[3].image.values[1], 1.0f);
+    EXPECT_EQ(maps[3].high, 1.2);
+}
+
+TEST(MaterialMapKeys, EveryMistakeIsRefusedAtItsLocation) {
+    expectRefused("[[material.map]]\nshape = \"box\"\n", 10, "property is missing");
+    expectRefused("[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
+                  "expected one of \"E\", \"fracture_energy\", \"density\", found \"stiffness\"");
+    expectRefused(
+        "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
+        "factor = 2.0\n",
+        10, "radius is missing");
+    expectRefused(
+        "[[material.map]]\nproperty = \"E\"\nshape = \"box\"\nmin = [0.0, 0.0]\n"
+        "max = [0.1, 0.1]\nfactor = 2.0\nradius = 0.1\n",
+        16, "no radius for shape = \"box\"");
+    expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"noise\"\namplitude = 1.5\n", 13,
+                  "amplitude");
+    expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"image\"\nfile = \"none.png\"\n",
+                  13, "a PNG file of at most 256 MiB");
+    expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"image\"\nfile = \".\"\n", 13,
+                  "a PNG file of at most 256 MiB");  // a folder, never read
+    std::ofstream(test::scratchDir() / "text.png") << "not a png";
+    expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"image\"\nfile = \"text.png\"\n",
+                  13, "expected a PNG image");
+    expectRefused(
+        "[[material.map]]\nproperty = \"E\"\nshape = \"box\"\nmin = [0.0, 0.0]\n"
+        "max = [0.1, 0.1]\nfactor = 0.0\n",
+        15, "factor");
+}
+
+TEST(MaterialMapKeys, AMapOfWhatTheSceneLacksOrItsSolverCannotTakeIsRefused) {
+    const std::string message = refusal(
+        "[[material.map]]\nproperty = \"fracture_energy\"\nshape = \"disc\"\n"
+        "center = [0.0, 0.0]\nradius = 0.1\nfactor = 2.0\n",
+        {"material.fracture_energy=\"none\""});
+    EXPECT_NE(message.find("a material that breaks"), std::string::npos) << message;
+    const std::string solver = refusal(
+        "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
+        "radius = 0.1\nfactor = 2.0\n",
+        {"solver=fem_cst"});
+    EXPECT_NE(solver.find("does not take a material map of E or fracture_energy"),
+              std::string::npos)
+        << solver;
+    EXPECT_EQ(refusal("[[material.map]]\nproperty = \"density\"\nshape = \"disc\"\n"
+                      "center = [0.0, 0.0]\nradius = 0.1\nfactor = 2.0\n",
+                      {"solver=fem_cst"}),
+              "")
+        << "every solver takes the masses";
+}

@@ -1,0 +1,167 @@
+// Issue 15's material maps (sim/MaterialMap.h): each shape's factor field, and a map that
+// changes only the property it names.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "sim/MaterialMap.h"
+#include "sim/Membrane.h"
+#include "tests/sim/Peridynamic.h"
+
+using namespace rend::sim;
+
+namespace {
+
+std::vector<Eigen::Vector3d> grid(int n, double spacing) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) points.emplace_back(i * spacing, j * spacing, 0.0);
+    return points;
+}
+
+MaterialMap region(MapShape shape, double factor) {
+    MaterialMap m;
+    m.shape = shape;
+    m.factor = factor;
+    return m;
+}
+
+MembraneParams sheet() {
+    MembraneParams p;
+    p.sheet.size = {0.4, 0.2};
+    p.sheet.dx = 0.02;
+    p.material.fractureEnergy = 1.0;
+    return p;
+}
+
+}  // namespace
+
+TEST(MaterialMap, RegionsScaleInsideAndLeaveOutsideAlone) {
+    const std::vector<Eigen::Vector3d> points{{0.1, 0.1, 0}, {0.5, 0.5, 0}, {0.9, 0.2, 0}};
+    MaterialMap box = region(MapShape::Box, 3.0);
+    box.min = {0.0, 0.0}, box.max = {0.6, 0.6};
+    MaterialMap disc = region(MapShape::Disc, 0.5);
+    disc.center = {0.9, 0.2}, disc.radius = 0.05;
+    MaterialMap triangle = region(MapShape::Polygon, 2.0);
+    triangle.polygon = {{0.0, 0.0}, {0.3, 0.0}, {0.0, 0.3}};
+    const std::vector<MaterialMap> maps{box, disc, triangle};
+    EXPECT_EQ(materialFactors(MappedProperty::YoungsModulus, maps, points),
+              (std::vector<double>{6.0, 3.0, 0.5}))
+        << "maps of one property multiply";
+    EXPECT_EQ(materialFactors(MappedProperty::Density, maps, points), (std::vector<double>(3, 1.0)))
+        << "no map of density";
+}
+
+TEST(MaterialMap, NoiseIsSeededBoundedAndStretchedAlongItsLongCells) {
+    const std::vector<Eigen::Vector3d> points = grid(40, 0.01);
+    MaterialMap noise;
+    noise.shape = MapShape::Noise;
+    noise.amplitude = 0.6;
+    noise.scale = {0.2, 0.02};  // fibres along x
+    const std::vector<MaterialMap> maps{noise};
+    const std::vector<double> a = materialFactors(MappedProperty::YoungsModulus, maps, points);
+    EXPECT_EQ(a, materialFactors(MappedProperty::YoungsModulus, maps, points)) << "seeded";
+    const auto [low, high] = std::minmax_element(a.begin(), a.end());
+    EXPECT_GE(*low, 0.4);
+    EXPECT_LE(*high, 1.6);
+    EXPECT_GT(*high - *low, 0.4) << "it varies";
+    // Neighbours along the fibres differ far less than across them.
+    double along = 0, across = 0;
+    for (int i = 0; i + 1 < 40; ++i)
+        for (int j = 0; j + 1 < 40; ++j) {
+            along += std::abs(a[(i + 1) * 40 + j] - a[i * 40 + j]);
+            across += std::abs(a[i * 40 + j + 1] - a[i * 40 + j]);
+        }
+    EXPECT_LT(3 * along, across);
+    std::vector<MaterialMap> reseeded = maps;
+    reseeded[0].seed = 2;
+    EXPECT_NE(a, materialFactors(MappedProperty::YoungsModulus, reseeded, points));
+}
+
+TEST(MaterialMap, AnImageSpansTheRestBoundsLowInBlackHighInWhite) {
+    MaterialMap image;
+    image.property = MappedProperty::Density;
+    image.shape = MapShape::Image;
+    image.low = 0.5, image.high = 2.0;
+    image.image = {2, 2, {0.0f, 1.0f, 1.0f, 1.0f}};  // top-left black
+    const std::vector<Eigen::Vector3d> points{{0, 1, 0}, {1, 1, 0}, {0, 0, 0}, {1, 0, 0}};
+    EXPECT_EQ(materialFactors(MappedProperty::Density, std::vector<MaterialMap>{image}, points),
+              (std::vector<double>{0.5, 2.0, 2.0, 2.0}));
+}
+
+// A density map changes the masses and nothing of the bonds; an E map the bonds' stiffness
+// and critical stretch (as sqrt(G_f / E)) and not the masses; a fracture-energy map only the
+// critical stretch.
+TEST(MaterialMap, AMapChangesOnlyWhatItNames) {
+    const Membrane plain(sheet());
+    const auto withMap = [](MappedProperty property) {
+        MembraneParams p = sheet();
+        MaterialMap m = region(MapShape::Box, 4.0);
+        m.property = property;
+        m.min = {0.0, -1.0}, m.max = {1.0, 1.0};  // x >= 0
+        p.materialMaps = {m};
+        return p;
+    };
+    const Membrane dense(withMap(MappedProperty::Density)),
+        stiff(withMap(MappedProperty::YoungsModulus)),
+        tough(withMap(MappedProperty::FractureEnergy));
+    std::vector<Eigen::Vector3d> f0, f;
+    Membrane pulled(sheet()), pulledStiff(withMap(MappedProperty::YoungsModulus)),
+        pulledDense(withMap(MappedProperty::Density));
+    for (Membrane* m : {&pulled, &pulledStiff, &pulledDense})
+        for (int i = 0; i < m->particleCount(); ++i)
+            m->positions()[i].x() = 1.001 * m->restPositions()[i].x();
+    pulled.computeForces(f0);
+    pulledDense.computeForces(f);
+    EXPECT_EQ(f, f0) << "density leaves the forces";
+    pulledStiff.computeForces(f);
+    for (int i = 0; i < plain.particleCount(); ++i) {
+        const double x = plain.restPositions()[i].x();
+        const double ratio = dense.masses()[i] / plain.masses()[i];
+        EXPECT_DOUBLE_EQ(ratio, x >= 0 ? 4.0 : 1.0) << i;
+        EXPECT_EQ(stiff.masses()[i], plain.masses()[i]);
+        EXPECT_EQ(tough.masses()[i], plain.masses()[i]);
+        if (x > 0.05) EXPECT_NEAR(f[i].norm(), 4.0 * f0[i].norm(), 1e-9 * f0[i].norm() + 1e-18);
+        if (x < -0.05) EXPECT_NEAR(f[i].norm(), f0[i].norm(), 1e-12 + 1e-9 * f0[i].norm());
+    }
+    EXPECT_LT(stiff.stableTimeStep(), plain.stableTimeStep());
+    EXPECT_NEAR(dense.stableTimeStep(), plain.stableTimeStep(), 1e-9 * plain.stableTimeStep())
+        << "heavier particles on one side: the lighter side still sets the step";
+    EXPECT_EQ(rend::test::criticalStretch(tough), rend::test::criticalStretch(plain))
+        << "the reference is the material's; the map scales each bond";
+}
+
+// A fracture-energy map scales each bond's critical stretch by sqrt(G_f): stretched to 1.5 times
+// the material's, the plain side breaks and the side four times as tough (twice the stretch)
+// holds.
+TEST(MaterialMap, AToughSideHoldsWhereThePlainSideBreaks) {
+    MembraneParams p = sheet();
+    p.time.dt = 1e-9;
+    MaterialMap tough = region(MapShape::Box, 4.0);
+    tough.property = MappedProperty::FractureEnergy;
+    tough.min = {0.0, -1.0}, tough.max = {1.0, 1.0};
+    p.materialMaps = {tough};
+    Membrane m(p);
+    const double stretch = 1.5 * rend::test::criticalStretch(m);
+    for (int i = 0; i < m.particleCount(); ++i)
+        m.positions()[i] = (1.0 + stretch) * m.restPositions()[i];
+    m.step();
+    const BondFamilies& bonds = m.bonds();
+    int brokenLeft = 0, brokenRight = 0, right = 0;
+    for (int i = 0; i < m.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            const int j = bonds.partners[b];
+            const bool broken = !m.damageState().bondAlive()[std::size_t(b)];
+            if (m.restPositions()[i].x() < -0.01 && m.restPositions()[j].x() < -0.01)
+                brokenLeft += broken;
+            if (m.restPositions()[i].x() > 0.01 && m.restPositions()[j].x() > 0.01)
+                brokenRight += broken, ++right;
+        }
+    EXPECT_GT(brokenLeft, 0);
+    EXPECT_GT(right, 0);
+    EXPECT_EQ(brokenRight, 0);
+}

@@ -140,8 +140,25 @@ FemCst::FemCst(const Lattice& lattice, const Material& material, double thicknes
 }
 
 std::unique_ptr<Solver> FemCst::make(const SolverSetUp& s) {
-    return std::make_unique<FemCst>(s.lattice, s.material, s.params.sheet.thickness,
-                                    bandCriticalStrain(s.params));
+    auto fem = std::make_unique<FemCst>(s.lattice, s.material, s.params.sheet.thickness,
+                                        bandCriticalStrain(s.params));
+    fem->applyMaterialMaps(s.params.materialMaps, s.rest);
+    return fem;
+}
+
+void FemCst::applyMaterialMaps(std::span<const MaterialMap> maps,
+                               std::span<const Eigen::Vector3d> rest) {
+    if (!mapsProperty(maps, MappedProperty::YoungsModulus) &&
+        !mapsProperty(maps, MappedProperty::FractureEnergy))
+        return;
+    const std::vector<double> e = materialFactors(MappedProperty::YoungsModulus, maps, rest);
+    const std::vector<double> g = materialFactors(MappedProperty::FractureEnergy, maps, rest);
+    for (Element& element : elements_) {
+        double sumE = 0.0, sumG = 0.0;
+        for (const int v : element.v) sumE += e[v], sumG += g[v];
+        element.stiffness = sumE / 3.0;
+        element.strength = std::sqrt(sumG / sumE);
+    }
 }
 
 void FemCst::findNeighbours() {
@@ -201,14 +218,14 @@ void FemCst::forces(const StepState& s, Workspace& work,
         Eigen::Matrix2d S;
         if (linear) {
             const Eigen::Matrix2d E = 0.5 * (F.transpose() * F - Eigen::Matrix2d::Identity());
-            S = material_.stiffnessFactor(theta) *
+            S = e.stiffness * material_.stiffnessFactor(theta) *
                 (lambda_ * E.trace() * Eigen::Matrix2d::Identity() + 2.0 * mu_ * E);
         } else {
             Eigen::Matrix<double, 3, 2> rate;
             if (ahead) rate = deformationGradient(e, s.v) / stretch;
-            S = material_.stiffnessFactor(theta) * nonlinearStress(t, F, stretchesOf(F), nullptr,
-                                                                   ahead ? &rate : nullptr, s.dt,
-                                                                   ahead ? &lowest : nullptr);
+            S = e.stiffness * material_.stiffnessFactor(theta) *
+                nonlinearStress(t, F, stretchesOf(F), nullptr, ahead ? &rate : nullptr, s.dt,
+                                ahead ? &lowest : nullptr);
         }
         const Eigen::Matrix<double, 3, 2> H =
             -e.restArea * thickness_ / stretch * F * S * e.restInverse.transpose();
@@ -240,8 +257,8 @@ std::vector<double> FemCst::stiffnessRowSums(int particleCount) const {
         const Eigen::Vector2d g[3] = {-g1 - g2, g1, g2};
         const double total = g[0].norm() + g[1].norm() + g[2].norm();
         for (int a = 0; a < 3; ++a)
-            sums[e.v[a]] += e.restArea * thickness_ * (lambda_ + 2.0 * mu_) * g[a].norm() * total *
-                            std::sqrt(2.0) / 2.0;
+            sums[e.v[a]] += e.stiffness * e.restArea * thickness_ * (lambda_ + 2.0 * mu_) *
+                            g[a].norm() * total * std::sqrt(2.0) / 2.0;
     }
     return sums;
 }
@@ -327,7 +344,7 @@ bool FemCst::pastCriticalStrain(int t, std::span<const Eigen::Vector3d> x,
     // Largest principal Green strain of the mechanical part against the critical stretch's,
     // (l^2 - 1) / 2, with l = 1 + eps_c weakened by theta.
     const double theta = thetaOf(elements_[t], thetas);
-    const double limit = criticalStrain_ * material_.strengthFactor(theta);
+    const double limit = criticalStrain_ * elements_[t].strength * material_.strengthFactor(theta);
     const double stretch = 1.0 + expansion_ * theta;
     const Eigen::Matrix2d E =
         0.5 * ((greenStrain(t, x) * 2.0 + Eigen::Matrix2d::Identity()) / (stretch * stretch) -
@@ -387,7 +404,8 @@ double FemCst::strainEnergy(const StepState& s, Workspace&) const {
             const Eigen::Matrix<double, 3, 2> F = deformationGradient(elements_[t], x) / stretch;
             nonlinearStress(t, F, stretchesOf(F), &density);
         }
-        sum += elements_[t].restArea * thickness_ * material_.stiffnessFactor(theta) * density;
+        sum += elements_[t].stiffness * elements_[t].restArea * thickness_ *
+               material_.stiffnessFactor(theta) * density;
     }
     return sum;
 }

@@ -99,8 +99,13 @@ private:
         double restArea;              ///< A0
         int triangle;                 ///< index into the lattice's triangles
         std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
+        double stiffness = 1.0;       ///< E over the material's: its corners' mean (maps)
+        double strength = 1.0;        ///< the critical strain's factor, sqrt(G_f / E) (maps)
     };
     void findNeighbours();
+    /// Issue 15's material maps: each element's E and critical strain from its corners'.
+    void applyMaterialMaps(std::span<const MaterialMap> maps,
+                           std::span<const Eigen::Vector3d> rest);
     /// Mean theta over the element's corners (0 without diffusion).
     static double thetaOf(const Element& e, std::span<const double> theta);
     /// Removes element t's triangle from the DamageState, and with `breakSides` breaks the

@@ -26,7 +26,7 @@ constexpr std::array kSolvers{
                 "gradient of the energy); the power law and elastoplastic law on the principal "
                 "stretches",
                 "seminar report",
-                {true, true, true, false, false, false},
+                {true, true, true, false, false, true},
                 &FemCst::make},
     SolverEntry{"mass_spring_vg",
                 "one spring per triangle edge, Van Gelder's k (eq. 1)",

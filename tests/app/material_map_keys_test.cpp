@@ -128,7 +128,7 @@ TEST(MaterialMapKeys, AMapOfWhatTheSceneLacksOrItsSolverCannotTakeIsRefused) {
     const std::string solver = refusal(
         "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
         "radius = 0.1\nfactor = 2.0\n",
-        {"solver=fem_cst"});
+        {"solver=mass_spring_vg"});
     EXPECT_NE(solver.find("does not take a material map of E or fracture_energy"),
               std::string::npos)
         << solver;

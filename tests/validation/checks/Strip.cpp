@@ -167,9 +167,11 @@ double stripModulus(const Strip& s) {
     return sol.reaction / (crossSection(s, params, sol) * strainMid) / kE;
 }
 
-BimaterialFigures bimaterialStrip(double softFactor) {
-    const Strip s{true, 20, 1.5, true};
+BimaterialFigures bimaterialStrip(double softFactor, const std::string& solver) {
+    // The FEM has no missing bonds at the edges, so no surface correction to take.
+    const Strip s{true, 20, 1.5, solver == "peridynamic"};
     MembraneParams params = stripParams(s);
+    params.solver = solver;
     MaterialMap soft;
     soft.property = MappedProperty::YoungsModulus;
     soft.shape = MapShape::Box;

@@ -12,6 +12,8 @@
 // at strain 1e-6), then E_strip = reaction / (h W e_mid) with e_mid fitted over the middle half,
 // away from the grips. The outermost row's modulus 1 - d is read from two widths.
 
+#include <string>
+
 #include "sim/Membrane.h"
 
 namespace rend::checks {
@@ -39,7 +41,8 @@ struct SkinFigures {
 
 SkinFigures skin(bool alongX, double horizonFactor, bool corrected);
 
-/// Issue 15's bimaterial strip: the surface-corrected strip (20 cells, R = 1.5 dx) with an E
+/// Issue 15's bimaterial strip: the strip (20 cells, R = 1.5 dx, surface-corrected for the
+/// peridynamic bonds) of `solver` with an E
 /// map making its half x > 0 `softFactor` times as stiff, pulled by its grips. In series both
 /// halves carry the same stress, so each half's strain is stress / its E (the closed form):
 /// the figures are each half's measured modulus over its own, 1 when the map is exact.
@@ -47,6 +50,6 @@ struct BimaterialFigures {
     double stiff;  ///< E measured in x < 0 over E
     double soft;   ///< E measured in x > 0 over softFactor E
 };
-BimaterialFigures bimaterialStrip(double softFactor);
+BimaterialFigures bimaterialStrip(double softFactor, const std::string& solver = "peridynamic");
 
 }  // namespace rend::checks

@@ -12,15 +12,16 @@
 namespace rend::sim {
 
 MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material& material,
-                       double thickness, double criticalStrain)
+                       double thickness, double criticalStrain, std::span<const MaterialMap> maps)
     : model_(model),
       material_(material),
       poisson_(material.poissonRatio()),
       law_(material.law(1.0)),
       expansion_(material.expansion()),
       criticalStrain_(criticalStrain) {
-    const double E = material.youngsModulus(), t = thickness, nu = poisson_;
+    const double t = thickness, nu = poisson_;
     const auto& p = lattice.positions;
+    const std::vector<double> eFactor = materialFactors(MappedProperty::YoungsModulus, maps, p);
     std::map<std::pair<int, int>, int> index;
     auto springOf = [&](int a, int b) {
         const auto key = std::minmax(a, b);
@@ -37,6 +38,8 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         }
         tri.restArea = 0.5 * (p[v[1]] - p[v[0]]).cross(p[v[2]] - p[v[0]]).norm();
         if (tri.restArea <= 0.0) continue;
+        const double E =
+            material.youngsModulus() * (eFactor[v[0]] + eFactor[v[1]] + eFactor[v[2]]) / 3.0;
         tri.fixedPart = E * t / (8.0 * (1.0 - nu * nu) * tri.restArea);  // eq. 12
         for (int s = 0; s < 3; ++s) {
             const double c2 = tri.restLength[s] * tri.restLength[s];
@@ -61,17 +64,25 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         particleSprings_[fill[springs_[s].j]++] = -(s + 1);
     }
     if (law_.kind == BondLawKind::Elastoplastic) plastic_.assign(springs_.size(), {});
+    if (mapsProperty(maps, MappedProperty::YoungsModulus) ||
+        mapsProperty(maps, MappedProperty::FractureEnergy)) {
+        const std::vector<double> g = materialFactors(MappedProperty::FractureEnergy, maps, p);
+        for (const Spring& s : springs_)
+            strength_.push_back(std::sqrt((g[s.i] + g[s.j]) / (eFactor[s.i] + eFactor[s.j])));
+    }
     bindOwn({}, n, lattice.triangles);
 }
 
 std::unique_ptr<Solver> MassSpring::makeVanGelder(const SolverSetUp& s) {
     return std::make_unique<MassSpring>(s.lattice, SpringModel::VanGelder, s.material,
-                                        s.params.sheet.thickness, springCriticalStrain(s.params));
+                                        s.params.sheet.thickness, springCriticalStrain(s.params),
+                                        s.params.materialMaps);
 }
 
 std::unique_ptr<Solver> MassSpring::makeTwoParameter(const SolverSetUp& s) {
     return std::make_unique<MassSpring>(s.lattice, SpringModel::TwoParameter, s.material,
-                                        s.params.sheet.thickness, bandCriticalStrain(s.params));
+                                        s.params.sheet.thickness, bandCriticalStrain(s.params),
+                                        s.params.materialMaps);
 }
 
 void MassSpring::onBind() {
@@ -96,7 +107,9 @@ void MassSpring::fracture(const StepState& state, Workspace&) {
         double thetaBar;
         const double eta = mechanicalStrain(s, state, thetaBar);
         if (!plastic_.empty()) plastic_[s] = law_.yieldStep(eta, plastic_[s]);  // eq. 20
-        if (!(eta > criticalStrain_ * material_.strengthFactor(thetaBar))) continue;
+        const double limit = criticalStrain_ * material_.strengthFactor(thetaBar) *
+                             (strength_.empty() ? 1.0 : strength_[s]);
+        if (!(eta > limit)) continue;
         damage_->breakEdge(s);  // serial, in spring order
     }
 }

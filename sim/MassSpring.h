@@ -63,8 +63,10 @@ public:
     /// criticalStrain: a spring breaks once stretched past it (infinity: never). Both models
     /// take the material's bond law (its shape, see above), its thermal strain alpha theta_bar
     /// and its stiffness and strength losses, as the bonds do.
+    /// `maps`: issue 15's material maps; a triangle takes its corners' mean E, a spring the
+    /// critical strain's factor sqrt(mean G_f / mean E) of its two ends.
     MassSpring(const Lattice& lattice, SpringModel model, const Material& material,
-               double thickness, double criticalStrain);
+               double thickness, double criticalStrain, std::span<const MaterialMap> maps = {});
     /// The registry's factories: Van Gelder's springs break at springCriticalStrain(), the
     /// two-parameter ones (whose triangles go with a side) at bandCriticalStrain().
     static std::unique_ptr<Solver> makeVanGelder(const SolverSetUp& s);
@@ -146,6 +148,7 @@ private:
     std::vector<PlasticState> plastic_;  ///< per spring; empty unless elastoplastic
     double stiffening_ = 1.0;
     double criticalStrain_;
+    std::vector<double> strength_;  ///< per spring, from material maps; empty: all 1
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;
     // Per particle, its springs (signed: +s+1 when it is end i, -(s+1) when end j), so each

@@ -71,10 +71,26 @@ std::unique_ptr<Solver> TotalLagrangianSph::make(const SolverSetUp& s) {
     if (s.params.sheet.outline == Outline::Sphere)
         throw std::invalid_argument("the sph solver needs a flat rest sheet");
     const MaterialParams& m = s.params.material;
-    return std::make_unique<TotalLagrangianSph>(
+    auto sph = std::make_unique<TotalLagrangianSph>(
         s.lattice, s.params.sheet.dx, s.material, s.params.sheet.thickness, s.params.notches,
         m.fractureEnergy ? sphCriticalStrain(*m.fractureEnergy, m.youngsModulus, s.params.sheet.dx)
                          : std::numeric_limits<double>::infinity());
+    sph->applyMaterialMaps(s.params.materialMaps);
+    return sph;
+}
+
+void TotalLagrangianSph::applyMaterialMaps(std::span<const MaterialMap> maps) {
+    if (!mapsProperty(maps, MappedProperty::YoungsModulus) &&
+        !mapsProperty(maps, MappedProperty::FractureEnergy))
+        return;
+    stiffness_ = materialFactors(MappedProperty::YoungsModulus, maps, rest_);
+    const std::vector<double> g = materialFactors(MappedProperty::FractureEnergy, maps, rest_);
+    pairStrength_.resize(neighbours_.size());
+    for (int i = 0; i < int(rest_.size()); ++i)
+        for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
+            const int j = neighbours_[k];
+            pairStrength_[k] = std::sqrt((g[i] + g[j]) / (stiffness_[i] + stiffness_[j]));
+        }
 }
 
 void TotalLagrangianSph::onBind() {
@@ -119,7 +135,8 @@ void TotalLagrangianSph::fracture(const StepState& s, Workspace& work) {
             const Eigen::Vector2d d = (rest_[j] - rest_[i]).head<2>() / pairs_.restLength[k];
             const double sj = 1.0 + expansion_ * thetaAt(theta, j);
             const double eta = (0.5 * (deformation[i] / si + deformation[j] / sj) * d).norm() - 1.0;
-            const double limit = criticalStrain_ * material_.strengthFactor(thetaBar);
+            const double limit = criticalStrain_ * material_.strengthFactor(thetaBar) *
+                                 (pairStrength_.empty() ? 1.0 : pairStrength_[k]);
             const double length = (x[j] - x[i]).norm() / pairs_.restLength[k];
             breaking_[k] = eta > limit || length > kTetherStretch;
             count += breaking_[k];
@@ -243,8 +260,9 @@ void TotalLagrangianSph::forcesFrom(const StepState& s, SphWorkspace& work,
     for (int i = 0; i < n; ++i) {
         // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
         const double stretch = 1.0 + expansion_ * thetaAt(s.theta, i);
-        stress[i] = volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) /
-                    stretch * firstPiola(i, deformation[i] / stretch);
+        stress[i] = stiffnessOf(i) * volume_[i] * thickness_ *
+                    material_.stiffnessFactor(thetaAt(s.theta, i)) / stretch *
+                    firstPiola(i, deformation[i] / stretch);
     }
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = 0; i < n; ++i) {
@@ -271,7 +289,8 @@ std::vector<double> TotalLagrangianSph::stiffnessRowSums(int particleCount) cons
             total += gradient_[k].norm();
         }
         total += own.norm();
-        const double scale = std::sqrt(0.5) * volume_[i] * thickness_ * (lambda_ + 2.0 * mu_);
+        const double scale =
+            std::sqrt(0.5) * stiffnessOf(i) * volume_[i] * thickness_ * (lambda_ + 2.0 * mu_);
         sums[i] += scale * own.norm() * total;
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k)
             sums[neighbours_[k]] += scale * gradient_[k].norm() * total;
@@ -286,7 +305,8 @@ double TotalLagrangianSph::strainEnergy(const StepState& s, Workspace&) const {
         const Eigen::Matrix<double, 3, 2> F =
             deformationGradient(i, x) / (1.0 + expansion_ * thetaAt(s.theta, i));
         const Eigen::Matrix2d E = greenStrain(i, F);
-        sum += volume_[i] * thickness_ * material_.stiffnessFactor(thetaAt(s.theta, i)) *
+        sum += stiffnessOf(i) * volume_[i] * thickness_ *
+               material_.stiffnessFactor(thetaAt(s.theta, i)) *
                (0.5 * lambda_ * E.trace() * E.trace() + mu_ * (E.array() * E.array()).sum());
     }
     return sum;

@@ -119,6 +119,8 @@ private:
         return theta.empty() ? 0.0 : theta[i];
     }
 
+    void applyMaterialMaps(std::span<const MaterialMap> maps);
+
     // CSR neighbours of each particle with their corrected gradients g_ij; `mirror[k]` is the
     // index of the pair j -> i in j's list.
     BondFamilies pairs_;                   ///< rest neighbours within 2 dx
@@ -131,6 +133,10 @@ private:
     std::vector<Eigen::Vector2d> gradient_;
     std::vector<double> volume_;
     double lambda_ = 0.0, mu_ = 0.0, thickness_ = 0.0;
+    // Issue 15's material maps; empty: 1 everywhere.
+    std::vector<double> stiffness_;     ///< per particle, E over the material's
+    std::vector<double> pairStrength_;  ///< per pair copy, sqrt(mean G_f / mean E) of its ends
+    double stiffnessOf(int i) const { return stiffness_.empty() ? 1.0 : stiffness_[i]; }
 
     // Fracture: a pair past the critical strain loses its gradient; the particle keeps its rest
     // correction and measures strain against its rest metric C0_i = B_i^T B_i (see the top).

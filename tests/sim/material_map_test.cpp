@@ -6,11 +6,13 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "sim/Fracture.h"
 #include "sim/MaterialMap.h"
 #include "sim/Membrane.h"
+#include "sim/TotalLagrangianSph.h"
 #include "tests/sim/Peridynamic.h"
 
 using namespace rend::sim;
@@ -175,6 +177,56 @@ TEST(MaterialMap, TheFemsToughSideHoldsWhereThePlainSideBreaks) {
     const auto [left, right] = brokenEachSide(p, 1.5 * bandCriticalStrain(p));
     EXPECT_GT(left, 0);
     EXPECT_EQ(right, 0);
+}
+
+// And the SPH's pairs, each by its two ends.
+TEST(MaterialMap, TheSphsToughSideHoldsWhereThePlainSideBreaks) {
+    MembraneParams p = sheet();
+    p.solver = "sph";
+    const double strain =
+        sphCriticalStrain(*p.material.fractureEnergy, p.material.youngsModulus, p.sheet.dx);
+    const auto [left, right] = brokenEachSide(p, 1.5 * strain);
+    EXPECT_GT(left, 0);
+    EXPECT_EQ(right, 0);
+}
+
+// And the springs of both mass-spring models, each by its two ends.
+TEST(MaterialMap, TheSpringsToughSideHoldsWhereThePlainSideBreaks) {
+    for (const char* solver : {"mass_spring_vg", "mass_spring_tp"}) {
+        MembraneParams p = sheet();
+        p.solver = solver;
+        const double strain = std::string(solver) == "mass_spring_vg" ? springCriticalStrain(p)
+                                                                      : bandCriticalStrain(p);
+        const auto [left, right] = brokenEachSide(p, 1.5 * strain);
+        EXPECT_GT(left, 0) << solver;
+        EXPECT_EQ(right, 0) << solver;
+    }
+}
+
+// An E map stiffens the springs' side: the two-parameter model's triangles and Van Gelder's
+// springs both pull four times as hard where E is four times the material's.
+TEST(MaterialMap, TheSpringsTakeAnEMap) {
+    for (const char* solver : {"mass_spring_vg", "mass_spring_tp"}) {
+        MembraneParams plainParams = sheet();
+        plainParams.solver = solver;
+        MembraneParams stiffParams = plainParams;
+        MaterialMap stiff = region(MapShape::Box, 4.0);
+        stiff.min = {0.0, -1.0}, stiff.max = {1.0, 1.0};
+        stiffParams.materialMaps = {stiff};
+        Membrane plain(plainParams), stiffened(stiffParams);
+        std::vector<Eigen::Vector3d> f0, f;
+        for (Membrane* m : {&plain, &stiffened})
+            for (int i = 0; i < m->particleCount(); ++i)
+                m->positions()[i].x() = 1.001 * m->restPositions()[i].x();
+        plain.computeForces(f0);
+        stiffened.computeForces(f);
+        for (int i = 0; i < plain.particleCount(); ++i) {
+            const double x = plain.restPositions()[i].x();
+            if (x > 0.05)
+                EXPECT_NEAR(f[i].norm(), 4.0 * f0[i].norm(), 1e-6 * f0[i].norm()) << solver;
+            if (x < -0.05) EXPECT_NEAR(f[i].norm(), f0[i].norm(), 1e-6 * f0[i].norm()) << solver;
+        }
+    }
 }
 
 TEST(MaterialMap, AToughSideHoldsWhereThePlainSideBreaks) {

@@ -52,7 +52,9 @@ TEST(ValidationStrip, SurfaceCorrectionKeepsTheInteriorAndTheStableTimeStepClose
 // of the displacement: piecewise linear with those slopes). The E map must give each half its
 // modulus; VALIDATION.md's 2%.
 TEST(ValidationBimaterial, EachHalfOfAStiffAndSoftStripStrainsAsItsOwnModulusWithinTwoPercent) {
-    for (const char* solver : {"peridynamic", "fem_cst"})
+    // The two-parameter springs' forces are no energy's gradient, so the strip's conjugate
+    // gradients cannot solve them; their map is tested in MaterialMap.*.
+    for (const char* solver : {"peridynamic", "fem_cst", "sph", "mass_spring_vg"})
         for (const double ratio : {0.25, 0.5, 4.0}) {
             const BimaterialFigures f = bimaterialStrip(ratio, solver);
             std::printf(
@@ -63,6 +65,8 @@ TEST(ValidationBimaterial, EachHalfOfAStiffAndSoftStripStrainsAsItsOwnModulusWit
             EXPECT_NEAR(f.soft / f.stiff, 1.0, 0.02) << solver << " " << ratio;
             // The strip's modulus: the bonds' with the surface correction is E; the FEM's
             // triangles span N - 1 rows of the N cells the measure counts, (N - 1) / N = 0.95.
+            // Van Gelder's springs carry their own strip modulus (README "Solvers").
+            if (std::string(solver) == "mass_spring_vg") continue;
             const double own = std::string(solver) == "fem_cst" ? 19.0 / 20.0 : 1.0;
             EXPECT_NEAR(f.stiff, own, 0.02) << solver << " " << ratio;
             EXPECT_NEAR(f.soft, own, 0.02) << solver << " " << ratio;

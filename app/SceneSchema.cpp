@@ -127,7 +127,9 @@ constexpr Param kMaterialMap[] = {
     {"points", T::Points, kLength, "required for a polygon",
      "the polygon's corners [[x, y], ...] in rest coordinates, metres",
      "[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]"},
-    {"scale", T::Vec2, positive(1e4), "[0.1, 0.1]",
+    // At least a micrometre: the noise's lattice index (coordinate / scale, 2^7 times finer at
+    // the last octave) must stay a 64-bit integer.
+    {"scale", T::Vec2, closed(1e-6, 1e4), "[0.1, 0.1]",
      "the noise's cell size along x and y in metres (unequal: fibres)", "[0.2, 0.02]"},
     {"amplitude", T::Number, closed(0.0, 0.99), "0.5", "the noise's factor spans 1 +- amplitude",
      "0.6"},

@@ -106,6 +106,8 @@ TEST(MaterialMapKeys, EveryMistakeIsRefusedAtItsLocation) {
         16, "no radius for shape = \"box\"");
     expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"noise\"\namplitude = 1.5\n", 13,
                   "amplitude");
+    expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"noise\"\nscale = [1e-300, 0.1]\n",
+                  13, "in [1e-06, 10000]");  // the noise's lattice index must stay an integer
     expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"image\"\nfile = \"none.png\"\n",
                   13, "a PNG file of at most 256 MiB");
     expectRefused("[[material.map]]\nproperty = \"E\"\nshape = \"image\"\nfile = \".\"\n", 13,

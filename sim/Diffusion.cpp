@@ -23,10 +23,14 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
     const double interior = interiorFamilySum(
         bonds, [&](int b) { return bonds.weight[b] * volumes[bonds.partners[b]]; });
     K_ = interior > 0.0 ? 4.0 * m.conductivity / interior : 0.0;
-    const double rhoC = m.density * m.capacity;
+    // A density map changes the thermal mass rho C too (per particle: the flux between two
+    // particles stays equal and opposite, so the heat, the sum of rho C V theta, is kept).
+    const std::vector<double> density =
+        materialFactors(MappedProperty::Density, params.materialMaps, rest);
     rate_.resize(bonds.directedCount());
     double worst = 0.0;
     for (int i = 0; i < n; ++i) {
+        const double rhoC = m.density * density[i] * m.capacity;
         double total = 0.0;
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
             const double xi = bonds.restLength[b];

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/Diffusion.h"
 #include "sim/Fracture.h"
 #include "sim/MaterialMap.h"
 #include "sim/Membrane.h"
@@ -234,4 +235,22 @@ TEST(MaterialMap, AToughSideHoldsWhereThePlainSideBreaks) {
     const auto [left, right] = brokenEachSide(sheet(), 1.5 * rend::test::criticalStretch(plain));
     EXPECT_GT(left, 0);
     EXPECT_EQ(right, 0);
+}
+
+// The density is the diffusion's too: four times the density is four times the thermal mass
+// rho C, so theta spreads four times slower and its explicit step may be four times longer.
+TEST(MaterialMap, ADensityMapIsTheDiffusionsThermalMassToo) {
+    MembraneParams p = sheet();
+    p.material.conductivity = 0.01;
+    p.diffusion.initial = 1.0;
+    const Membrane plain(p);
+    MaterialMap dense = region(MapShape::Box, 4.0);
+    dense.property = MappedProperty::Density;
+    dense.min = {-1.0, -1.0}, dense.max = {1.0, 1.0};  // the whole sheet
+    p.materialMaps = {dense};
+    const Membrane heavy(p);
+    ASSERT_NE(plain.diffusion(), nullptr);
+    ASSERT_NE(heavy.diffusion(), nullptr);
+    EXPECT_NEAR(heavy.diffusion()->stableTimeStep(), 4.0 * plain.diffusion()->stableTimeStep(),
+                1e-12 * plain.diffusion()->stableTimeStep());
 }

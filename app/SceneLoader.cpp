@@ -451,6 +451,12 @@ void readForces(const TableReader& root, sim::MembraneParams& p) {
     p.pressure = t.number("pressure").value_or(p.pressure);
 }
 
+void readMpm(const TableReader& root, sim::MpmParams& mpm) {
+    const TableReader t = root.section("mpm");
+    mpm.grid = t.number("grid").value_or(mpm.grid);
+    mpm.enrich = t.boolean("enrich").value_or(mpm.enrich);
+}
+
 void readTime(const TableReader& root, Scene& scene) {
     const TableReader t = root.section("time");
     sim::TimeParams& time = scene.sim.time;
@@ -714,6 +720,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     s.sim.notches = readNotches(root, s.sim.sheet);
     s.sim.diffusion = readDiffusion(root, s);
     readForces(root, s.sim);
+    readMpm(root, s.sim.mpm);
     readSolver(root, s.sim);
     readTime(root, s);
     s.render.camera = readCamera(root, s.sim.sheet);

@@ -48,6 +48,7 @@ const Param kRoot[] = {
      {},
      "diffusion"},
     {"forces", T::Table, {}, "", "external forces", "", {}, "forces"},
+    {"mpm", T::Table, {}, "", "the MPM solver's background grid", "", {}, "mpm"},
     {"contact", T::Table, {}, "", "the ground and self-contact", "", {}, "contact"},
     {"collider", T::Tables, {}, "", "a kinematic collider", "", {}, "collider"},
     {"time", T::Table, {}, "", "time stepping", "", {}, "time"},
@@ -334,6 +335,21 @@ constexpr Param kForces[] = {
      "100.0"},
 };
 
+constexpr Param kMpm[] = {
+    {"grid", T::Number, closed(0.25, 8.0), "0.5",
+     "the background grid's spacing over `sheet.dx` (read by `solver = \"mpm\"` only); at 1 "
+     "or more the grid has fewer nodes than the sheet has particles and locks part of the "
+     "motion",
+     "1.0"},
+    {"enrich",
+     T::Boolean,
+     {},
+     "true",
+     "seed 002's enrichment: particles in the grid cells of a material boundary or a crack "
+     "are solved on their own domains, not averaged by the grid",
+     "false"},
+};
+
 constexpr Range kFriction = closed(0.0, 10.0);
 
 constexpr Param kContact[] = {
@@ -611,6 +627,7 @@ const Section kSchema[] = {
     {"diffusion.edge", "[[diffusion.edge]]", kDiffusionEdge},
     {"diffusion.edge.box", "box", kBox},
     {"forces", "[forces]", kForces},
+    {"mpm", "[mpm]", kMpm},
     {"contact", "[contact]", kContact},
     {"collider", "[[collider]]", kCollider},
     {"collider.keyframe", "[[collider.keyframe]]", kKeyframe},

@@ -161,6 +161,27 @@ void Contact::resolveParticle(Eigen::Vector3d& x, Eigen::Vector3d& v) const {
     }
 }
 
+void Contact::resolveNodeVelocity(const Eigen::Vector3d& at, Eigen::Vector3d& v,
+                                  double reach) const {
+    const double offset = offset_ + reach;
+    for (std::size_t c = 0; c < poses_.size(); ++c) {
+        const ColliderPose& pose = poses_[c];
+        if ((at - pose.position).norm() >= std::sqrt(colliderReach2_[c]) + reach) continue;
+        const std::optional<SurfaceDistance> local = signedDistance(
+            params_.colliders[c], meshes_[c] ? &*meshes_[c] : nullptr, pose.toLocal(at));
+        if (!local || local->distance >= offset) continue;
+        Eigen::Vector3d x = at;
+        pushOut(x, v, {local->distance, pose.rotation * local->normal}, pose.velocityAt(at),
+                params_.colliders[c].friction);
+    }
+    const GroundParams& ground = params_.ground;
+    if (ground.enabled && at.z() < ground.height + offset) {
+        Eigen::Vector3d x = at;
+        pushOut(x, v, {at.z() - ground.height, Eigen::Vector3d::UnitZ()}, Eigen::Vector3d::Zero(),
+                ground.friction);
+    }
+}
+
 void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
                                std::span<const double> mass, std::span<const std::uint8_t> free) {
     const int n = int(x.size());

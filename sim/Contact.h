@@ -69,6 +69,11 @@ public:
     void resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
                           std::span<const double> mass, std::span<const std::uint8_t> free);
 
+    /// A grid node's velocity v at `at` against the ground and the colliders (the MPM's grid
+    /// collision, sim/Mpm.h): within `reach` of a surface and moving into it, its normal
+    /// velocity is removed and friction applies, as for a particle; the node is not moved.
+    void resolveNodeVelocity(const Eigen::Vector3d& at, Eigen::Vector3d& v, double reach) const;
+
     /// The sheet's state at a force evaluation, as self-contact reads it.
     struct SheetState {
         std::span<const Eigen::Vector3d> x, v, rest;

@@ -94,6 +94,8 @@ void Membrane::assignBoundaries() {
         for (int i = 0; i < particleCount(); ++i)
             if (bc.region.contains(x0_[i])) constraint_[i] = tag;
     }
+    free_.resize(x0_.size());
+    for (std::size_t i = 0; i < x0_.size(); ++i) free_[i] = constraint_[i] == kFree;
 }
 
 // The contact thickness d defaults to half the spacing, never below the sheet's thickness. The
@@ -111,8 +113,6 @@ void Membrane::setUpContact(const MembraneParams& params) {
         std::max(0.25 * restRate, 4.0 * 8.0 * params.gravity.norm() / thickness);
     contact_.emplace(params.contact, thickness, horizon_, baseRate, lattice_.triangles, x0_);
     if (self.enabled) setStableStep(restRate + 2.0 * baseRate);
-    free_.resize(x0_.size());
-    for (std::size_t i = 0; i < x0_.size(); ++i) free_[i] = constraint_[i] == kFree;
 }
 
 int Membrane::nearestParticle(const Eigen::Vector2d& at) const {
@@ -181,10 +181,19 @@ void Membrane::integrate(double dt, double tNext) {
     const int n = particleCount();
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
+    if (solver_->carriesMomentum()) {  // MPM: the kick, the grid, then the drift
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        updateVelocity(i, kickDt, tNext, gravity, damping);
-        x_[i] += dt * v_[i];
+        for (int i = 0; i < n; ++i) updateVelocity(i, kickDt, tNext, gravity, damping);
+        if (contact_ && contact_->hasColliders()) contact_->place(tNext - dt);
+        solver_->transferMomentum({x_, mass_, free_, dt, contact_ ? &*contact_ : nullptr}, v_);
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+        for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
+    } else {
+#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+        for (int i = 0; i < n; ++i) {
+            updateVelocity(i, kickDt, tNext, gravity, damping);
+            x_[i] += dt * v_[i];
+        }
     }
     collide(tNext);
 }
@@ -274,6 +283,8 @@ void Membrane::stepVelocityVerlet() {
         for (int i = 0; i < n; ++i) x_[i] += h * v_[i];
         accumulateForces();  // at x^n+1
         kick(0.5 * h, time_ + done + h);
+        if (solver_->carriesMomentum())
+            solver_->transferMomentum({x_, mass_, free_, h, contact_ ? &*contact_ : nullptr}, v_);
         done += h;
     }
     forcesCurrent_ = true;

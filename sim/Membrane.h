@@ -195,7 +195,7 @@ private:
     std::size_t notched_ = 0;
     std::optional<Diffusion> diffusion_;
     std::optional<Contact> contact_;
-    std::vector<std::uint8_t> free_;  ///< per particle: 1 unless pinned or driven (contact only)
+    std::vector<std::uint8_t> free_;  ///< per particle: 1 unless pinned or driven
     double contactSeconds_ = 0.0;
     double horizon_ = 0.0;
     double stableDt_ = 0.0;

@@ -181,6 +181,12 @@ struct TimeParams {
     bool adaptive() const { return !dt && control == StepControl::Adaptive; }
 };
 
+/// The MPM solver's grid (solver = "mpm", sim/Mpm.h).
+struct MpmParams {
+    double grid = 0.5;   ///< the background grid's spacing over sheet.dx
+    bool enrich = true;  ///< seed 002's enrichment at material boundaries and cracks
+};
+
 struct MembraneParams {
     /// Which discretisation turns positions into internal forces, by its name in the solver
     /// registry (sim/SolverRegistry.h): "peridynamic" is the membrane paper's bonds.
@@ -196,6 +202,7 @@ struct MembraneParams {
     DiffusionParams diffusion;
     ContactParams contact;                  ///< ground, colliders, self-contact (sim/Contact.h)
     std::vector<MaterialMap> materialMaps;  ///< E, G_f and density over the sheet
+    MpmParams mpm;
 };
 
 }  // namespace rend::sim

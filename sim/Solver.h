@@ -28,6 +28,7 @@
 namespace rend::sim {
 
 struct SolverSetUp;  // sim/SolverRegistry.h: what a solver's factory builds it from
+class Contact;       // sim/Contact.h: the ground and colliders a grid's nodes collide with
 
 /// One step's state, passed explicitly.
 struct StepState {
@@ -35,6 +36,15 @@ struct StepState {
     std::span<const Eigen::Vector3d> v;  ///< velocities; empty where only forces are asked
     std::span<const double> theta;       ///< the diffusing quantity; empty without diffusion
     double dt = 0.0;                     ///< the step about to be taken [s]
+};
+
+/// What a solver that carries momentum through a grid (Solver::transferMomentum) reads.
+struct TransferState {
+    std::span<const Eigen::Vector3d> x;  ///< positions the velocities are about to move
+    std::span<const double> mass;
+    std::span<const std::uint8_t> free;  ///< per particle: 0 where pinned or driven
+    double dt = 0.0;
+    const Contact* contact = nullptr;  ///< the ground and colliders, placed; none: nullptr
 };
 
 /// A solver's scratch for one force evaluation (per-element or per-spring intermediates). Each
@@ -91,6 +101,12 @@ public:
     /// default: a solver without history keeps it all in the DamageState.
     virtual void saveState(StateWriter& out) const {}
     virtual void loadState(StateReader& in) {}
+
+    /// Whether the solver carries momentum through a background grid (MPM): the Membrane then
+    /// hands it every step's new velocities, before they move the particles.
+    virtual bool carriesMomentum() const { return false; }
+    /// Replaces the velocities v (after the kick, at s.x) by the grid's; see sim/Mpm.h.
+    virtual void transferMomentum(const TransferState& s, std::span<Eigen::Vector3d> v) {}
 
     /// Set-up, before anything else: the Membrane's bonds and the DamageState the solver reads
     /// in forces() and changes in advance(); both outlive the solver.

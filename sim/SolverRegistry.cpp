@@ -7,6 +7,7 @@
 
 #include "sim/FemCst.h"
 #include "sim/MassSpring.h"
+#include "sim/Mpm.h"
 #include "sim/PeridynamicBonds.h"
 #include "sim/TotalLagrangianSph.h"
 
@@ -45,6 +46,12 @@ constexpr std::array kSolvers{
                 "membrane paper, Sec. 6.1",
                 {false, true, false, false, false, true},
                 &TotalLagrangianSph::make},
+    SolverEntry{"mpm",
+                "codimensional MPM: the FEM's lattice forces, momentum through a 3D grid with "
+                "APIC; particles near material boundaries and cracks solved on their own domains",
+                "enhanced MPM paper (seed 002)",
+                {true, true, true, false, false, true},
+                &Mpm::make},
 };
 
 std::string joined(const std::vector<std::string>& items, std::string_view last) {

@@ -28,7 +28,8 @@ struct Row {
 };
 constexpr Row kSolvers[] = {{"fem_cst", "fem_cst"},
                             {"mass_spring_tp", "mass_spring_tp"},
-                            {"mass_spring_vg", "mass_spring_vg"}};
+                            {"mass_spring_vg", "mass_spring_vg"},
+                            {"mpm", "mpm"}};
 
 /// Bubble height and Hencky's, at `pressure`.
 std::pair<double, double> bubble(std::string solver, double pressure) {

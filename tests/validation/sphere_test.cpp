@@ -22,7 +22,8 @@ TEST(ValidationSphere, EachSolverMatchesItsClosedFormAndTheTableOfTheMassSpringP
             const char* name;
         } rows[] = {{"fem_cst", "fem_cst"},
                     {"mass_spring_vg", "mass_spring_vg"},
-                    {"mass_spring_tp", "mass_spring_tp"}};
+                    {"mass_spring_tp", "mass_spring_tp"},
+                    {"mpm", "mpm"}};
         std::printf("E = %.0f MPa, h = %.1f mm: log-strain reference %.5f\n", mat.E / 1e6,
                     mat.h * 1e3, reference);
         for (const auto& row : rows) {

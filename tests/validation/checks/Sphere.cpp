@@ -77,7 +77,7 @@ double logStrainStretch(const Material& mat) {
 
 double closedFormStretch(const std::string& solver, const Material& mat) {
     const double k = kPressure * kRadius * (1 - kNu) / (mat.E * mat.h);
-    if (solver == "fem_cst") return svkStretch(k);
+    if (solver == "fem_cst" || solver == "mpm") return svkStretch(k);  // the FEM's forces
     if (solver == "mass_spring_vg")
         return springStretch(kPressure * kRadius /
                              (2 * std::sqrt(3.0) * vanGelderTriangle() * mat.E * mat.h));

@@ -457,6 +457,11 @@ void readMpm(const TableReader& root, sim::MpmParams& mpm) {
     mpm.enrich = t.boolean("enrich").value_or(mpm.enrich);
 }
 
+void readRemesh(const TableReader& root, sim::RemeshParams& remesh) {
+    const TableReader t = root.section("remesh");
+    if (const auto every = t.integer("every")) remesh.every = int(*every);
+}
+
 void readTime(const TableReader& root, Scene& scene) {
     const TableReader t = root.section("time");
     sim::TimeParams& time = scene.sim.time;
@@ -721,6 +726,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     s.sim.diffusion = readDiffusion(root, s);
     readForces(root, s.sim);
     readMpm(root, s.sim.mpm);
+    readRemesh(root, s.sim.remesh);
     readSolver(root, s.sim);
     readTime(root, s);
     s.render.camera = readCamera(root, s.sim.sheet);

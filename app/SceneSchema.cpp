@@ -49,6 +49,14 @@ const Param kRoot[] = {
      "diffusion"},
     {"forces", T::Table, {}, "", "external forces", "", {}, "forces"},
     {"mpm", T::Table, {}, "", "the MPM solver's background grid", "", {}, "mpm"},
+    {"remesh",
+     T::Table,
+     {},
+     "",
+     "seed 004's remeshing of the particle solvers (peridynamic, sph)",
+     "",
+     {},
+     "remesh"},
     {"contact", T::Table, {}, "", "the ground and self-contact", "", {}, "contact"},
     {"collider", T::Tables, {}, "", "a kinematic collider", "", {}, "collider"},
     {"time", T::Table, {}, "", "time stepping", "", {}, "time"},
@@ -350,6 +358,13 @@ constexpr Param kMpm[] = {
      "false"},
 };
 
+constexpr Param kRemesh[] = {
+    {"every", T::Integer, closed(1.0, 1e6), "never",
+     "steps between remeshes: positions and velocities refitted with the M4' kernel over each "
+     "particle's intact bonds in rest coordinates",
+     "10"},
+};
+
 constexpr Range kFriction = closed(0.0, 10.0);
 
 constexpr Param kContact[] = {
@@ -628,6 +643,7 @@ const Section kSchema[] = {
     {"diffusion.edge.box", "box", kBox},
     {"forces", "[forces]", kForces},
     {"mpm", "[mpm]", kMpm},
+    {"remesh", "[remesh]", kRemesh},
     {"contact", "[contact]", kContact},
     {"collider", "[[collider]]", kCollider},
     {"collider.keyframe", "[[collider.keyframe]]", kKeyframe},

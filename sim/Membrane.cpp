@@ -46,6 +46,7 @@ Membrane::Membrane(const MembraneParams& given)
         theta_ = diffusion_->initialTheta();
     }
     if (params.contact.any()) setUpContact(params);
+    if (params.remesh.every > 0) remesher_.emplace(x0_, bonds_, sheet.dx);
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
     controller_ = TimeStepController(params.time);
     const MaterialParams& m = params.material;
@@ -295,6 +296,10 @@ void Membrane::step() {
         stepVelocityVerlet();
     else
         stepSymplecticEuler();
+    if (remesher_ && (steps_ + 1) % params_.remesh.every == 0) {
+        remesher_->remesh(x_, v_, mass_, damageState_.bondAlive(), free_);
+        forcesCurrent_ = false;
+    }
     if (diffusion_) {
         diffusion_->advance(theta_, bonds_, damageState_.bondAlive(), time_,
                             dt_);  // theta^n -> theta^n+1

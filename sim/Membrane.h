@@ -27,6 +27,7 @@
 #include "sim/Parallel.h"
 #include "sim/Params.h"
 #include "sim/Random.h"
+#include "sim/Remesh.h"
 #include "sim/Solver.h"
 #include "sim/StateArchive.h"
 #include "sim/TimeStep.h"
@@ -205,6 +206,7 @@ private:
     BlowUpGuard guard_;
     std::unique_ptr<Solver> solver_;        ///< the internal forces
     std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
+    std::optional<Remesher> remesher_;      ///< remesh.every > 0
     double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     double lastDrift_ = 0.0;   ///< the last symplectic Euler drift, 0 before the first

@@ -187,6 +187,11 @@ struct MpmParams {
     bool enrich = true;  ///< seed 002's enrichment at material boundaries and cracks
 };
 
+/// Seed 004's remeshing (sim/Remesh.h) for the particle solvers.
+struct RemeshParams {
+    int every = 0;  ///< steps between remeshes; 0: never
+};
+
 struct MembraneParams {
     /// Which discretisation turns positions into internal forces, by its name in the solver
     /// registry (sim/SolverRegistry.h): "peridynamic" is the membrane paper's bonds.
@@ -203,6 +208,7 @@ struct MembraneParams {
     ContactParams contact;                  ///< ground, colliders, self-contact (sim/Contact.h)
     std::vector<MaterialMap> materialMaps;  ///< E, G_f and density over the sheet
     MpmParams mpm;
+    RemeshParams remesh;
 };
 
 }  // namespace rend::sim

@@ -15,12 +15,12 @@ namespace rend::sim {
 namespace {
 
 // One line per solver. SolverSupport: {bondLaws, fracture, sphere, paperCriticalStretch,
-// surfaceCorrection, materialMaps}.
+// surfaceCorrection, materialMaps, remesh}.
 constexpr std::array kSolvers{
     SolverEntry{"peridynamic",
                 "bond forces (eqs. 18-20), fracture, diffusion coupling",
                 "membrane paper",
-                {true, true, true, true, true, true},
+                {true, true, true, true, true, true, true},
                 &PeridynamicBonds::make},
     SolverEntry{"fem_cst",
                 "constant-strain triangles, St. Venant-Kirchhoff in plane stress (the exact "
@@ -44,7 +44,7 @@ constexpr std::array kSolvers{
                 "kernel-corrected total-Lagrangian SPH (rest neighbours within 2 dx), St. "
                 "Venant-Kirchhoff as the FEM; fracture by damage-weighted pairs",
                 "membrane paper, Sec. 6.1",
-                {false, true, false, false, false, true},
+                {false, true, false, false, false, true, true},
                 &TotalLagrangianSph::make},
     SolverEntry{"mpm",
                 "codimensional MPM: the FEM's lattice forces, momentum through a 3D grid with "
@@ -100,6 +100,9 @@ std::string unsupportedFeatures(const SolverEntry& solver, const MembraneParams&
     if (!can.materialMaps && (mapsProperty(params.materialMaps, MappedProperty::YoungsModulus) ||
                               mapsProperty(params.materialMaps, MappedProperty::FractureEnergy)))
         wanted.push_back("a material map of E or fracture_energy");
+    if (params.remesh.every > 0 && !can.remesh) wanted.push_back("remesh");
+    if (params.remesh.every > 0 && params.sheet.outline == Outline::Sphere)
+        wanted.push_back("remesh on a sphere (it remeshes in the flat rest plane)");
     return joined(wanted, " and ");
 }
 
@@ -119,6 +122,7 @@ std::string solverTableMarkdown() {
         if (can.fracture) takes.push_back("fracture");
         if (can.sphere) takes.push_back("sphere");
         if (can.materialMaps) takes.push_back("material maps");
+        if (can.remesh) takes.push_back("`remesh`");
         if (can.paperCriticalStretch) takes.push_back("`critical_stretch = \"paper\"`");
         if (can.surfaceCorrection) takes.push_back("`surface_correction`");
         out += "| `" + std::string(e.name) + "` | " + std::string(e.model) + " | " +

@@ -26,6 +26,7 @@ struct SolverSupport {
     bool paperCriticalStretch = false;  ///< critical_stretch = "paper" (eq. 28 as printed)
     bool surfaceCorrection = false;     ///< surface_correction = true
     bool materialMaps = false;          ///< maps of E and fracture_energy (density: every one)
+    bool remesh = false;                ///< remesh = { every = N } (seed 004, sim/Remesh.h)
 };
 
 /// What a factory builds a solver from: the scene, its validated material, the rest lattice,

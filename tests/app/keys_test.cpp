@@ -158,6 +158,7 @@ std::vector<Variation> variations() {
          {"boundary.0.velocity=[-2.0, 0.0, 0.0]", "material.fracture_energy=0.5"}},
         {"material.strength_loss", {"material.strength_loss=0.9"}, pull},
         {"material.surface_correction", {"material.surface_correction=true"}},
+        {"remesh.every", {"remesh.every=5"}, {"boundary.0.velocity=[-2.0, 0.0, 0.0]"}},
         {"mpm.grid", {"mpm.grid=2.0"}, {"solver=mpm", "boundary.0.velocity=[-2.0, 0.0, 0.0]"}},
         {"mpm.enrich",
          {"mpm.enrich=false"},

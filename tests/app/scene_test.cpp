@@ -256,13 +256,13 @@ TEST_P(BadSceneTest, NamesLocationKeyExpectationAndFinding) {
 INSTANTIATE_TEST_SUITE_P(
     Files, BadSceneTest,
     ::testing::Values(
-        BadScene{
-            "bad_unknown_key.toml",
-            "6:2",
-            {"unknown key 'materal' in the top-level table; expected one of: solver, sheet, "
-             "material, boundary, notch, diffusion, forces, mpm, contact, collider, time, camera, "
-             "light, render, output. Did "
-             "you mean 'material'?"}},
+        BadScene{"bad_unknown_key.toml",
+                 "6:2",
+                 {"unknown key 'materal' in the top-level table; expected one of: solver, sheet, "
+                  "material, boundary, notch, diffusion, forces, mpm, remesh, contact, collider, "
+                  "time, camera, "
+                  "light, render, output. Did "
+                  "you mean 'material'?"}},
         BadScene{"bad_sub_key.toml",
                  "13:1",
                  {"unknown key 'velocty' in [[boundary]] entry 0", "Did you mean 'velocity'?"}},

@@ -183,18 +183,21 @@ double angularMomentumZ(const Membrane& m) {
 
 }  // namespace
 
-SpinFigures spinningSheet(const std::string& solver, int steps, const MpmParams& mpm) {
+SpinFigures spinningSheet(const std::string& solver, int steps, const MpmParams& mpm, bool disc,
+                          int remeshEvery) {
     MembraneParams p;
     p.solver = solver;
     p.mpm = mpm;
+    p.remesh.every = remeshEvery;
     p.sheet.size = {0.4, 0.4};
+    if (disc) p.sheet.outline = Outline::Disc, p.sheet.radius = 0.2;
     p.sheet.dx = 0.02;
     p.material.youngsModulus = 2e4;
     p.material.density = 5000;
     Membrane probe(p);
     p.time.dt = 0.5 * probe.stableTimeStep();
     Membrane m(p);
-    const double spin = 1.0;  // rad/s: centrifugal strain rho w^2 R^2 / E about 1%
+    const double spin = disc ? std::sqrt(10.0) : 1.0;  // rho w^2 R^2 / E about 10% or 1%
     for (int i = 0; i < m.particleCount(); ++i)
         m.velocities()[i] = spin * Eigen::Vector3d::UnitZ().cross(m.positions()[i]);
     const double L0 = angularMomentumZ(m), ke0 = m.kineticEnergy();

@@ -38,14 +38,17 @@ PullFigures pulledBimaterial(const std::string& solver, double dx, const sim::Mp
 /// jerk, against the FEM's run.
 PullFigures pulledStripes(double dx, double stripe, const sim::MpmParams& mpm);
 
-/// A free square sheet (0.4 m, dx 0.02) spun about its normal at `spin` rad/s with a small
-/// radial stretch, no gravity or damping, for `steps` steps: the relative change of its angular
-/// momentum about its centre of mass.
+/// A free square sheet (0.4 m, dx 0.02) spun about its normal at 1 rad/s (a centrifugal strain
+/// of about 1%), no gravity or damping, for `steps` steps at half the stable step: the relative
+/// change of its angular momentum about its centre of mass. Seed 004's figure (its Sec. 5.4, a
+/// spinning disc) with `disc`: a disc of radius 0.2 m spun at 3.16 rad/s (strain about 10%),
+/// remeshed every `remeshEvery` steps (0: never).
 struct SpinFigures {
     double angularMomentumDrift;  ///< |L_end - L_0| / |L_0|
     double kineticEnergyRatio;    ///< KE_end / KE_0
 };
-SpinFigures spinningSheet(const std::string& solver, int steps, const sim::MpmParams& mpm = {});
+SpinFigures spinningSheet(const std::string& solver, int steps, const sim::MpmParams& mpm = {},
+                          bool disc = false, int remeshEvery = 0);
 
 /// Collision through the grid against the contact of the other solvers: a sheet (0.2 x 0.4 m,
 /// dx 0.02) cut across y = 0, its upper half laid 4 cm over its lower half on the ground and

@@ -91,6 +91,11 @@ sim::MaterialMap readMap(const TableReader& t, const Scene& scene) {
     m.low = t.number("low").value_or(m.low);
     m.high = t.number("high").value_or(m.high);
     if (m.shape == sim::MapShape::Image) m.image = readImage(t, scene);
+    if (m.property == sim::MappedProperty::YieldStrain &&
+        scene.sim.material.law != sim::BondLawKind::Elastoplastic) {
+        t.fail("property", "a material with law = \"elastoplastic\"", "\"yield_strain\"",
+               "Give [material] law = \"elastoplastic\", or map another property.");
+    }
     if (m.property == sim::MappedProperty::FractureEnergy && !scene.sim.material.fractureEnergy) {
         t.fail("property", "a material that breaks (fracture_energy is \"none\")",
                "\"fracture_energy\"", "Give [material] fracture_energy, or map another property.");

@@ -98,6 +98,8 @@ std::string mappedPropertyName(MappedProperty property) {
             return "fracture_energy";
         case MappedProperty::Density:
             return "density";
+        case MappedProperty::YieldStrain:
+            return "yield_strain";
     }
     return "";
 }

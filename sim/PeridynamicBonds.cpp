@@ -51,6 +51,16 @@ void PeridynamicBonds::computeBondScales(const MembraneParams& params, double pa
     const double c = paper ? paperMicromodulus(m.youngsModulus, m.poissonRatio, horizon_)
                            : calibratedMicromodulus(m.youngsModulus, interiorWeightedVolume);
     law_ = BondLaw::fromMaterial(m, c);
+    applyYieldMap(params.materialMaps);
+}
+
+void PeridynamicBonds::applyYieldMap(std::span<const MaterialMap> maps) {
+    if (!mapsProperty(maps, MappedProperty::YieldStrain)) return;
+    const std::vector<double> y = materialFactors(MappedProperty::YieldStrain, maps, rest_);
+    yieldFactor_.resize(bonds_.directedCount());
+    for (int i = 0; i < bonds_.particleCount(); ++i)
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            yieldFactor_[b] = 0.5 * (y[i] + y[bonds_.partners[b]]);
 }
 
 std::vector<double> PeridynamicBonds::stiffnessRowSums(int particleCount) const {
@@ -176,6 +186,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const double* restLength = bonds_.restLength.data();
     const double* bondScale = bondScale_.data();
     const double* stretchFactor = stretchFactor_.empty() ? nullptr : stretchFactor_.data();
+    const double* yieldFactor = yieldFactor_.empty() ? nullptr : yieldFactor_.data();
     const std::uint8_t* alive = damage_->bondAlive().data();
     std::uint8_t* proposed = updates.proposed;
     PlasticState* plastic = updates.plastic;
@@ -213,8 +224,10 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
                 }
             }
             PlasticState state;
+            double yield = 1.0;  // eta0's factor: the law runs in units of the bond's own eta0
             if constexpr (kLaw == BondLawKind::Elastoplastic) {
-                state = law_.yieldStep(eta, plasticIn[b]);
+                if (yieldFactor) yield = yieldFactor[b];
+                state = law_.yieldStep(eta / yield, plasticIn[b]);
                 if constexpr (kUpdateBonds) plastic[b] = state;
             }
             if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
@@ -228,7 +241,11 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
                     stiffest = std::max(stiffest, tangent);
                 }
             }
-            double f = law_.forceAs<kLaw>(eta, state);
+            double f;
+            if constexpr (kLaw == BondLawKind::Elastoplastic)
+                f = yield * law_.forceAs<kLaw>(eta / yield, state);
+            else
+                f = law_.forceAs<kLaw>(eta, state);
             if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
             sum += (bondScale[b] * f / length) * r;
         }
@@ -290,8 +307,9 @@ double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
             const double eta = mechanicalStrain(i, b, length, s.theta, thetaBar);
             const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
             // Each bond is stored from both ends: half of U_ij from each.
+            const double k = yieldOf(b);
             sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
-                   material_.stiffnessFactor(thetaBar) * law_.energy(eta, state);
+                   material_.stiffnessFactor(thetaBar) * k * k * law_.energy(eta / k, state);
         }
     return sum;
 }
@@ -306,7 +324,8 @@ Eigen::Matrix3d PeridynamicBonds::particleStress(int i, const StepState& s) cons
         double thetaBar;
         const double eta = mechanicalStrain(i, b, length, s.theta, thetaBar);
         const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
-        const double f = material_.stiffnessFactor(thetaBar) * law_.force(eta, state);
+        const double k = yieldOf(b);
+        const double f = material_.stiffnessFactor(thetaBar) * k * law_.force(eta / k, state);
         sigma += (bondScale_[b] * f / length) * r * r.transpose();
     }
     return sigma / (2.0 * volume_[i]);

@@ -56,6 +56,11 @@ private:
     void applySurfaceCorrection();
     void setUpFracture(const MaterialParams& m);
     void applyStiffnessMap(std::span<const MaterialMap> maps);
+    /// A yield_strain map: each bond's eta0 times the mean of its ends' factors. With k that
+    /// factor, eq. 20 at eta0 k is k f(eta / k) at eta0 (linear to k eta0, then the same decay
+    /// in eta / eta0), so the bond keeps its law in units of its own yield strain: its plastic
+    /// history is stored in them, and eq. 27's gamma follows unchanged.
+    void applyYieldMap(std::span<const MaterialMap> maps);
     void setUpStretchMap(std::span<const MaterialMap> maps);
     /// What the force loop may change: with kUpdateBonds (advance()) the plastic history and
     /// the proposed breaks, through these pointers; otherwise nothing.
@@ -86,7 +91,9 @@ private:
     std::vector<double> bondScale_;      ///< force on i per unit of f(eta), see BondLaw.h
     std::vector<double> stretchFactor_;  ///< per bond, from material maps; empty: all 1
     std::vector<PlasticState> plastic_;  ///< per bond; empty unless the law is elastoplastic
-    double stiffening_ = 1.0;            ///< the most compressed bond's, over c (advance() only)
+    std::vector<double> yieldFactor_;    ///< per bond, eta0 over the law's (maps); empty: all 1
+    double yieldOf(int b) const { return yieldFactor_.empty() ? 1.0 : yieldFactor_[b]; }
+    double stiffening_ = 1.0;  ///< the most compressed bond's, over c (advance() only)
 };
 
 }  // namespace rend::sim

@@ -15,12 +15,12 @@ namespace rend::sim {
 namespace {
 
 // One line per solver. SolverSupport: {bondLaws, fracture, sphere, paperCriticalStretch,
-// surfaceCorrection, materialMaps, remesh}.
+// surfaceCorrection, materialMaps, remesh, lawMaps}.
 constexpr std::array kSolvers{
     SolverEntry{"peridynamic",
                 "bond forces (eqs. 18-20), fracture, diffusion coupling",
                 "membrane paper",
-                {true, true, true, true, true, true, true},
+                {true, true, true, true, true, true, true, true},
                 &PeridynamicBonds::make},
     SolverEntry{"fem_cst",
                 "constant-strain triangles, St. Venant-Kirchhoff in plane stress (the exact "
@@ -101,6 +101,8 @@ std::string unsupportedFeatures(const SolverEntry& solver, const MembraneParams&
                               mapsProperty(params.materialMaps, MappedProperty::FractureEnergy)))
         wanted.push_back("a material map of E or fracture_energy");
     if (params.remesh.every > 0 && !can.remesh) wanted.push_back("remesh");
+    if (!can.lawMaps && mapsProperty(params.materialMaps, MappedProperty::YieldStrain))
+        wanted.push_back("a material map of yield_strain");
     if (params.remesh.every > 0 && params.sheet.outline == Outline::Sphere)
         wanted.push_back("remesh on a sphere (it remeshes in the flat rest plane)");
     return joined(wanted, " and ");
@@ -122,6 +124,7 @@ std::string solverTableMarkdown() {
         if (can.fracture) takes.push_back("fracture");
         if (can.sphere) takes.push_back("sphere");
         if (can.materialMaps) takes.push_back("material maps");
+        if (can.lawMaps) takes.push_back("yield_strain maps");
         if (can.remesh) takes.push_back("`remesh`");
         if (can.paperCriticalStretch) takes.push_back("`critical_stretch = \"paper\"`");
         if (can.surfaceCorrection) takes.push_back("`surface_correction`");

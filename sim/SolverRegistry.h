@@ -27,6 +27,7 @@ struct SolverSupport {
     bool surfaceCorrection = false;     ///< surface_correction = true
     bool materialMaps = false;          ///< maps of E and fracture_energy (density: every one)
     bool remesh = false;                ///< remesh = { every = N } (seed 004, sim/Remesh.h)
+    bool lawMaps = false;               ///< maps of the bond law's yield_strain
 };
 
 /// What a factory builds a solver from: the scene, its validated material, the rest lattice,

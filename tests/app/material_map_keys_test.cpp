@@ -94,8 +94,10 @@ high = 1.2
 
 TEST(MaterialMapKeys, EveryMistakeIsRefusedAtItsLocation) {
     expectRefused("[[material.map]]\nshape = \"box\"\n", 10, "property is missing");
-    expectRefused("[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
-                  "expected one of \"E\", \"fracture_energy\", \"density\", found \"stiffness\"");
+    expectRefused(
+        "[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
+        "expected one of \"E\", \"fracture_energy\", \"density\", \"yield_strain\", found "
+        "\"stiffness\"");
     expectRefused(
         "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
         "factor = 2.0\n",
@@ -133,4 +135,12 @@ TEST(MaterialMapKeys, AFractureEnergyMapNeedsABreakingMaterialAndEverySolverTake
                           {std::string("solver=") + solver}),
                   "")
             << "every solver takes an E map: " << solver;
+    const std::string yield =
+        "[[material.map]]\nproperty = \"yield_strain\"\nshape = \"disc\"\n"
+        "center = [0.0, 0.0]\nradius = 0.1\nfactor = 0.5\n";
+    const std::string linear = refusal(yield);
+    EXPECT_NE(linear.find("law = \"elastoplastic\""), std::string::npos) << linear;
+    EXPECT_EQ(refusal(yield, {"material.law=elastoplastic"}), "");
+    const std::string fem = refusal(yield, {"material.law=elastoplastic", "solver=fem_cst"});
+    EXPECT_NE(fem.find("does not take a material map of yield_strain"), std::string::npos) << fem;
 }

@@ -148,6 +148,11 @@ std::unique_ptr<Solver> FemCst::make(const SolverSetUp& s) {
 
 void FemCst::applyMaterialMaps(std::span<const MaterialMap> maps,
                                std::span<const Eigen::Vector3d> rest) {
+    if (mapsProperty(maps, MappedProperty::YieldStrain)) {
+        const std::vector<double> y = materialFactors(MappedProperty::YieldStrain, maps, rest);
+        for (Element& element : elements_)
+            element.yield = (y[element.v[0]] + y[element.v[1]] + y[element.v[2]]) / 3.0;
+    }
     if (!mapsProperty(maps, MappedProperty::YoungsModulus) &&
         !mapsProperty(maps, MappedProperty::FractureEnergy))
         return;
@@ -328,11 +333,14 @@ void FemCst::yieldElement(int t, const Stretches& p) {
     const Principal elastic = principal(
         p.directions * p.strain.asDiagonal() * p.directions.transpose() - plasticStrain_[t]);
     // The total strain along the most stretched elastic direction, the bond's eta of eq. 20.
-    const double before = law_.plasticStrain({maxStrain_[t]});
+    // With a yield map's factor k the law is k f(eta / k), whose plastic strain is
+    // k kappa(T / k) (T kept in real units).
+    const double k = elements_[t].yield;
+    const double before = k * law_.plasticStrain({maxStrain_[t] / k});
     const double trial = elastic.value[0] + before;
     if (!(trial > maxStrain_[t])) return;
     maxStrain_[t] = trial;
-    const double flow = law_.plasticStrain({trial}) - before;
+    const double flow = k * law_.plasticStrain({trial / k}) - before;
     if (flow != 0.0) {
         const Eigen::Vector2d n = elastic.vectors.col(0);
         plasticStrain_[t] += flow * n * n.transpose();
@@ -421,7 +429,7 @@ void FemCst::advance(const StepState& s, Workspace& work, std::vector<Eigen::Vec
 }
 
 double FemCst::strengthLeft(int t) const {
-    return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t]});
+    return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t] / elements_[t].yield});
 }
 
 void FemCst::reportStrength(DamageState& damage) const {

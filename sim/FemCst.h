@@ -101,6 +101,7 @@ private:
         std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
         double stiffness = 1.0;       ///< E over the material's: its corners' mean (maps)
         double strength = 1.0;        ///< the critical strain's factor, sqrt(G_f / E) (maps)
+        double yield = 1.0;  ///< eta0 over the law's: its corners' mean (yield_strain maps)
     };
     void findNeighbours();
     /// Issue 15's material maps: each element's E and critical strain from its corners'.

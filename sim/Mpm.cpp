@@ -61,7 +61,8 @@ std::unique_ptr<Solver> Mpm::make(const SolverSetUp& s) {
 // Algorithm 1: the ends of a lattice edge whose properties differ are boundary particles.
 void Mpm::findMaterialBoundaries(std::span<const MaterialMap> maps) {
     for (const MappedProperty property :
-         {MappedProperty::YoungsModulus, MappedProperty::FractureEnergy, MappedProperty::Density}) {
+         {MappedProperty::YoungsModulus, MappedProperty::FractureEnergy, MappedProperty::Density,
+          MappedProperty::YieldStrain}) {
         if (!mapsProperty(maps, property)) continue;
         const std::vector<double> f = materialFactors(property, maps, restPositions_);
         for (const auto& [i, j] : edges_)

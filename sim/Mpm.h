@@ -23,8 +23,8 @@
 //
 // Seed 002's enrichment (Sec. 5.1). That sharing is also MPM's flaw for heterogeneous
 // material: particles of a stiff and a soft material in one cell average their motion.
-//   * Algorithm 1, at set-up: the two ends of a lattice edge whose E, fracture energy or
-//     density factor (material maps) differ by more than kMaterialJump are boundary
+//   * Algorithm 1, at set-up: the two ends of a lattice edge whose E, fracture energy,
+//     density or yield strain factor (material maps) differ by more than kMaterialJump are boundary
 //     particles. So are, as the sheet tears, the corners of every triangle a crack removed:
 //     seed 002 claims MPM's advantage with topology change, and a crack is a boundary the grid
 //     would otherwise glue shut.

@@ -27,7 +27,7 @@ constexpr std::array kSolvers{
                 "gradient of the energy); the power law and elastoplastic law on the principal "
                 "stretches",
                 "seminar report",
-                {true, true, true, false, false, true},
+                {true, true, true, false, false, true, false, true},
                 &FemCst::make},
     SolverEntry{"mass_spring_vg",
                 "one spring per triangle edge, Van Gelder's k (eq. 1)",
@@ -50,7 +50,7 @@ constexpr std::array kSolvers{
                 "codimensional MPM: the FEM's lattice forces, momentum through a 3D grid with "
                 "APIC; particles near material boundaries and cracks solved on their own domains",
                 "enhanced MPM paper (seed 002)",
-                {true, true, true, false, false, true},
+                {true, true, true, false, false, true, false, true},
                 &Mpm::make},
 };
 

@@ -91,9 +91,11 @@ sim::MaterialMap readMap(const TableReader& t, const Scene& scene) {
     m.low = t.number("low").value_or(m.low);
     m.high = t.number("high").value_or(m.high);
     if (m.shape == sim::MapShape::Image) m.image = readImage(t, scene);
-    if (m.property == sim::MappedProperty::YieldStrain &&
-        scene.sim.material.law != sim::BondLawKind::Elastoplastic) {
-        t.fail("property", "a material with law = \"elastoplastic\"", "\"yield_strain\"",
+    const bool lawMap = m.property == sim::MappedProperty::YieldStrain ||
+                        m.property == sim::MappedProperty::Softening;
+    if (lawMap && scene.sim.material.law != sim::BondLawKind::Elastoplastic) {
+        t.fail("property", "a material with law = \"elastoplastic\"",
+               "\"" + sim::mappedPropertyName(m.property) + "\"",
                "Give [material] law = \"elastoplastic\", or map another property.");
     }
     if (m.property == sim::MappedProperty::FractureEnergy && !scene.sim.material.fractureEnergy) {

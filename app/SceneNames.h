@@ -18,8 +18,8 @@ inline constexpr std::string_view kMicromoduli[] = {"calibrated", "paper"};
 inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplastic"};
 inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper", "preview",
                                                           "midway"};
-inline constexpr std::string_view kMappedProperties[] = {"E", "fracture_energy", "density",
-                                                         "yield_strain"};  // sim::MappedProperty
+inline constexpr std::string_view kMappedProperties[] = {
+    "E", "fracture_energy", "density", "yield_strain", "softening"};  // sim::MappedProperty
 inline constexpr std::string_view kMapShapes[] = {"box", "disc", "polygon", "noise",
                                                   "image"};  // sim::MapShape
 inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};

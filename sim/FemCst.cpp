@@ -148,6 +148,11 @@ std::unique_ptr<Solver> FemCst::make(const SolverSetUp& s) {
 
 void FemCst::applyMaterialMaps(std::span<const MaterialMap> maps,
                                std::span<const Eigen::Vector3d> rest) {
+    if (mapsProperty(maps, MappedProperty::Softening)) {
+        const std::vector<double> b = materialFactors(MappedProperty::Softening, maps, rest);
+        for (Element& element : elements_)
+            element.softening = (b[element.v[0]] + b[element.v[1]] + b[element.v[2]]) / 3.0;
+    }
     if (mapsProperty(maps, MappedProperty::YieldStrain)) {
         const std::vector<double> y = materialFactors(MappedProperty::YieldStrain, maps, rest);
         for (Element& element : elements_)
@@ -336,11 +341,12 @@ void FemCst::yieldElement(int t, const Stretches& p) {
     // With a yield map's factor k the law is k f(eta / k), whose plastic strain is
     // k kappa(T / k) (T kept in real units).
     const double k = elements_[t].yield;
-    const double before = k * law_.plasticStrain({maxStrain_[t] / k});
+    const BondLaw law = lawOf(t);
+    const double before = k * law.plasticStrain({maxStrain_[t] / k});
     const double trial = elastic.value[0] + before;
     if (!(trial > maxStrain_[t])) return;
     maxStrain_[t] = trial;
-    const double flow = k * law_.plasticStrain({trial / k}) - before;
+    const double flow = k * law.plasticStrain({trial / k}) - before;
     if (flow != 0.0) {
         const Eigen::Vector2d n = elastic.vectors.col(0);
         plasticStrain_[t] += flow * n * n.transpose();
@@ -429,7 +435,7 @@ void FemCst::advance(const StepState& s, Workspace& work, std::vector<Eigen::Vec
 }
 
 double FemCst::strengthLeft(int t) const {
-    return maxStrain_.empty() ? 1.0 : law_.strengthLeft({maxStrain_[t] / elements_[t].yield});
+    return maxStrain_.empty() ? 1.0 : lawOf(t).strengthLeft({maxStrain_[t] / elements_[t].yield});
 }
 
 void FemCst::reportStrength(DamageState& damage) const {

@@ -101,7 +101,8 @@ private:
         std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
         double stiffness = 1.0;       ///< E over the material's: its corners' mean (maps)
         double strength = 1.0;        ///< the critical strain's factor, sqrt(G_f / E) (maps)
-        double yield = 1.0;  ///< eta0 over the law's: its corners' mean (yield_strain maps)
+        double yield = 1.0;      ///< eta0 over the law's: its corners' mean (yield_strain maps)
+        double softening = 1.0;  ///< beta over the law's: its corners' mean (softening maps)
     };
     void findNeighbours();
     /// Issue 15's material maps: each element's E and critical strain from its corners'.
@@ -148,6 +149,13 @@ private:
     /// Removes the flagged elements in index order (so the sides broken do not depend on
     /// the thread count) and clears the flags; see erode() for `breakSides`.
     void erodeFlagged(bool breakSides);
+
+    /// Element t's law: the material's, with its own beta where a softening map sets one.
+    BondLaw lawOf(int t) const {
+        BondLaw law = law_;
+        law.softening *= elements_[t].softening;
+        return law;
+    }
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each

@@ -100,6 +100,8 @@ std::string mappedPropertyName(MappedProperty property) {
             return "density";
         case MappedProperty::YieldStrain:
             return "yield_strain";
+        case MappedProperty::Softening:
+            return "softening";
     }
     return "";
 }

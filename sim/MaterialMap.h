@@ -15,7 +15,7 @@
 
 namespace rend::sim {
 
-enum class MappedProperty { YoungsModulus, FractureEnergy, Density, YieldStrain };
+enum class MappedProperty { YoungsModulus, FractureEnergy, Density, YieldStrain, Softening };
 enum class MapShape { Box, Disc, Polygon, Noise, Image };
 
 /// Grey levels in [0, 1], row 0 at the top (at the sheet's largest rest y), as images are stored.
@@ -43,7 +43,8 @@ struct MaterialMap {
     double low = 0.5, high = 1.5;          ///< image: the factors of black and white
 };
 
-/// The property's name as scenes spell it: "E", "fracture_energy", "density", "yield_strain".
+/// The property's name as scenes spell it: "E", "fracture_energy", "density", "yield_strain",
+/// "softening".
 std::string mappedPropertyName(MappedProperty property);
 
 /// Each particle's factor for `property`: the product of the maps that name it, 1 where none

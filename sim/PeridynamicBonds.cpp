@@ -55,12 +55,16 @@ void PeridynamicBonds::computeBondScales(const MembraneParams& params, double pa
 }
 
 void PeridynamicBonds::applyYieldMap(std::span<const MaterialMap> maps) {
-    if (!mapsProperty(maps, MappedProperty::YieldStrain)) return;
-    const std::vector<double> y = materialFactors(MappedProperty::YieldStrain, maps, rest_);
-    yieldFactor_.resize(bonds_.directedCount());
-    for (int i = 0; i < bonds_.particleCount(); ++i)
-        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-            yieldFactor_[b] = 0.5 * (y[i] + y[bonds_.partners[b]]);
+    for (const MappedProperty property : {MappedProperty::YieldStrain, MappedProperty::Softening}) {
+        if (!mapsProperty(maps, property)) continue;
+        const std::vector<double> y = materialFactors(property, maps, rest_);
+        std::vector<double>& factor =
+            property == MappedProperty::YieldStrain ? yieldFactor_ : softeningFactor_;
+        factor.resize(bonds_.directedCount());
+        for (int i = 0; i < bonds_.particleCount(); ++i)
+            for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+                factor[b] = 0.5 * (y[i] + y[bonds_.partners[b]]);
+    }
 }
 
 std::vector<double> PeridynamicBonds::stiffnessRowSums(int particleCount) const {
@@ -187,6 +191,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const double* bondScale = bondScale_.data();
     const double* stretchFactor = stretchFactor_.empty() ? nullptr : stretchFactor_.data();
     const double* yieldFactor = yieldFactor_.empty() ? nullptr : yieldFactor_.data();
+    const bool ownSoftening = !softeningFactor_.empty();
     const std::uint8_t* alive = damage_->bondAlive().data();
     std::uint8_t* proposed = updates.proposed;
     PlasticState* plastic = updates.plastic;
@@ -243,7 +248,8 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
             }
             double f;
             if constexpr (kLaw == BondLawKind::Elastoplastic)
-                f = yield * law_.forceAs<kLaw>(eta / yield, state);
+                f = yield *
+                    (ownSoftening ? lawOf(b) : law_).template forceAs<kLaw>(eta / yield, state);
             else
                 f = law_.forceAs<kLaw>(eta, state);
             if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
@@ -293,7 +299,7 @@ void PeridynamicBonds::advance(const StepState& s, Workspace&,
 
 void PeridynamicBonds::reportStrength(DamageState& damage) const {
     for (std::size_t b = 0; b < plastic_.size(); ++b)
-        damage.weaken(int(b), law_.strengthLeft(plastic_[b]));  // eq. 27
+        damage.weaken(int(b), lawOf(int(b)).strengthLeft(plastic_[b]));  // eq. 27
 }
 
 double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
@@ -309,7 +315,7 @@ double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
             // Each bond is stored from both ends: half of U_ij from each.
             const double k = yieldOf(b);
             sum += 0.5 * bondScale_[b] * bonds_.restLength[b] *
-                   material_.stiffnessFactor(thetaBar) * k * k * law_.energy(eta / k, state);
+                   material_.stiffnessFactor(thetaBar) * k * k * lawOf(b).energy(eta / k, state);
         }
     return sum;
 }
@@ -325,7 +331,7 @@ Eigen::Matrix3d PeridynamicBonds::particleStress(int i, const StepState& s) cons
         const double eta = mechanicalStrain(i, b, length, s.theta, thetaBar);
         const PlasticState state = plastic_.empty() ? PlasticState{} : plastic_[b];
         const double k = yieldOf(b);
-        const double f = material_.stiffnessFactor(thetaBar) * k * law_.force(eta / k, state);
+        const double f = material_.stiffnessFactor(thetaBar) * k * lawOf(b).force(eta / k, state);
         sigma += (bondScale_[b] * f / length) * r * r.transpose();
     }
     return sigma / (2.0 * volume_[i]);

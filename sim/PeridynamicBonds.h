@@ -88,11 +88,18 @@ private:
     double horizon_ = 0.0;
     BondLaw law_;
     double criticalStretch_ = 0.0;
-    std::vector<double> bondScale_;      ///< force on i per unit of f(eta), see BondLaw.h
-    std::vector<double> stretchFactor_;  ///< per bond, from material maps; empty: all 1
-    std::vector<PlasticState> plastic_;  ///< per bond; empty unless the law is elastoplastic
-    std::vector<double> yieldFactor_;    ///< per bond, eta0 over the law's (maps); empty: all 1
+    std::vector<double> bondScale_;        ///< force on i per unit of f(eta), see BondLaw.h
+    std::vector<double> stretchFactor_;    ///< per bond, from material maps; empty: all 1
+    std::vector<PlasticState> plastic_;    ///< per bond; empty unless the law is elastoplastic
+    std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
+    std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
     double yieldOf(int b) const { return yieldFactor_.empty() ? 1.0 : yieldFactor_[b]; }
+    /// Bond b's law: the material's, with its own beta where a softening map sets one.
+    BondLaw lawOf(int b) const {
+        BondLaw law = law_;
+        if (!softeningFactor_.empty()) law.softening *= softeningFactor_[b];
+        return law;
+    }
     double stiffening_ = 1.0;  ///< the most compressed bond's, over c (advance() only)
 };
 

@@ -94,10 +94,9 @@ high = 1.2
 
 TEST(MaterialMapKeys, EveryMistakeIsRefusedAtItsLocation) {
     expectRefused("[[material.map]]\nshape = \"box\"\n", 10, "property is missing");
-    expectRefused(
-        "[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
-        "expected one of \"E\", \"fracture_energy\", \"density\", \"yield_strain\", found "
-        "\"stiffness\"");
+    expectRefused("[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
+                  "expected one of \"E\", \"fracture_energy\", \"density\", \"yield_strain\", "
+                  "\"softening\", found \"stiffness\"");
     expectRefused(
         "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
         "factor = 2.0\n",
@@ -143,6 +142,7 @@ TEST(MaterialMapKeys, AFractureEnergyMapNeedsABreakingMaterialAndEverySolverTake
     EXPECT_EQ(refusal(yield, {"material.law=elastoplastic"}), "");
     const std::string springs =
         refusal(yield, {"material.law=elastoplastic", "solver=mass_spring_vg"});
-    EXPECT_NE(springs.find("does not take a material map of yield_strain"), std::string::npos)
+    EXPECT_NE(springs.find("does not take a material map of yield_strain or softening"),
+              std::string::npos)
         << springs;
 }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -302,7 +303,45 @@ TEST(MaterialMap, AYieldStrainMapYieldsOnlyWhereItLowersTheYield) {
     weak.property = MappedProperty::YieldStrain;
     fem.materialMaps = {weak};
     EXPECT_EQ(unsupportedFeatures(solverEntry("mass_spring_vg"), fem),
-              "a material map of yield_strain");
+              "a material map of yield_strain or softening");
     EXPECT_EQ(unsupportedFeatures(solverEntry("fem_cst"), fem), "");
     EXPECT_EQ(unsupportedFeatures(solverEntry("peridynamic"), fem), "");
+}
+
+// A softening map makes eq. 20 decay four times as fast on x > 0: stretched to 2 eta0, the
+// bonds (or elements) there keep exp(-4) of their strength against exp(-1) on x < 0.
+TEST(MaterialMap, ASofteningMapSoftensOnlyWhereItNames) {
+    for (const char* solver : {"peridynamic", "fem_cst", "mpm"}) {
+        SCOPED_TRACE(solver);
+        MembraneParams p = sheet();
+        p.solver = solver;
+        p.material.fractureEnergy.reset();
+        p.material.law = BondLawKind::Elastoplastic;
+        p.material.yieldStrain = 0.01;
+        p.material.softening = 1.0;
+        MaterialMap brittle = region(MapShape::Box, 4.0);
+        brittle.property = MappedProperty::Softening;
+        brittle.min = {0.0, -1.0};
+        brittle.max = {1.0, 1.0};
+        p.materialMaps = {brittle};
+        Membrane m(p);
+        for (int i = 0; i < m.particleCount(); ++i)
+            m.positions()[i] = (1.0 + 2.0 * 0.01) * m.restPositions()[i];
+        m.step();
+        m.updateDamage();
+        const BondFamilies& bonds = m.bonds();
+        double left = 1.0, right = 0.0;  // the weakest on the left, the strongest on the right
+        for (int i = 0; i < m.particleCount(); ++i)
+            for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+                const double xi = m.restPositions()[i].x();
+                const double xj = m.restPositions()[bonds.partners[b]].x();
+                const double gamma = m.damageState().strength()[b];
+                if (xi < -0.04 && xj < -0.04) left = std::min(left, gamma);
+                if (xi > 0.04 && xj > 0.04) right = std::max(right, gamma);
+            }
+        std::printf("%s: strength left at 2 eta0, beta 1: >= %.3f; beta 4: <= %.3f\n", solver, left,
+                    right);
+        EXPECT_GT(left, 0.2);
+        EXPECT_LT(right, 0.1);
+    }
 }

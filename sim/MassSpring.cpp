@@ -70,6 +70,12 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         for (const Spring& s : springs_)
             strength_.push_back(std::sqrt((g[s.i] + g[s.j]) / (eFactor[s.i] + eFactor[s.j])));
     }
+    for (const MappedProperty property : {MappedProperty::YieldStrain, MappedProperty::Softening}) {
+        if (!mapsProperty(maps, property)) continue;
+        const std::vector<double> f = materialFactors(property, maps, p);
+        std::vector<double>& factor = property == MappedProperty::YieldStrain ? yield_ : softening_;
+        for (const Spring& s : springs_) factor.push_back(0.5 * (f[s.i] + f[s.j]));
+    }
     bindOwn({}, n, lattice.triangles);
 }
 
@@ -106,7 +112,8 @@ void MassSpring::fracture(const StepState& state, Workspace&) {
         if (!springAlive(s)) continue;
         double thetaBar;
         const double eta = mechanicalStrain(s, state, thetaBar);
-        if (!plastic_.empty()) plastic_[s] = law_.yieldStep(eta, plastic_[s]);  // eq. 20
+        if (!plastic_.empty())
+            plastic_[s] = law_.yieldStep(eta / yieldOf(s), plastic_[s]);  // eq. 20
         const double limit = criticalStrain_ * material_.strengthFactor(thetaBar) *
                              (strength_.empty() ? 1.0 : strength_[s]);
         if (!(eta > limit)) continue;
@@ -126,7 +133,7 @@ void MassSpring::reportStrength(DamageState& damage) const {
     if (plastic_.empty()) return;
     for (int b = 0; b < int(damage.bondAlive().size()); ++b)
         if (const int s = damage.bondEdge(b); s >= 0)
-            damage.weaken(b, law_.strengthLeft(plastic_[s]));  // eq. 27's gamma of the side
+            damage.weaken(b, lawOf(s).strengthLeft(plastic_[s]));  // eq. 27's gamma of the side
 }
 
 double MassSpring::lowestStrain(const StepState& state) const {
@@ -170,8 +177,9 @@ void MassSpring::tensions(const StepState& state, SpringWorkspace& work) const {
             double thetaBar;
             const double eta = mechanicalStrain(s, state, thetaBar);
             const PlasticState plastic = plastic_.empty() ? PlasticState{} : plastic_[s];
-            tension[s] = springs_[s].k * springs_[s].restLength * law_.force(eta, plastic) *
-                         material_.stiffnessFactor(thetaBar);
+            const double k = yieldOf(s);
+            tension[s] = springs_[s].k * springs_[s].restLength * k *
+                         lawOf(s).force(eta / k, plastic) * material_.stiffnessFactor(thetaBar);
         }
         return;
     }
@@ -237,7 +245,10 @@ void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& w
             bool yielded = false;
             for (int s = 0; s < 3; ++s) {
                 const double strain = e.tangent[s];
-                const double p = strain - law_.forceAs<K>(strain, plastic_[tri.side[s]]);
+                const int side = tri.side[s];
+                const double k = yieldOf(side);
+                const double p =
+                    strain - k * lawOf(side).template forceAs<K>(strain / k, plastic_[side]);
                 yielded = yielded || p != 0.0;
                 rest[s] *= 1.0 + p;
             }
@@ -327,8 +338,9 @@ double MassSpring::strainEnergy(const StepState& state, Workspace& work) const {
             double thetaBar;
             const double eta = mechanicalStrain(s, state, thetaBar);
             const PlasticState plastic = plastic_.empty() ? PlasticState{} : plastic_[s];
-            sum += springs_[s].k * springs_[s].restLength * springs_[s].restLength *
-                   law_.energy(eta, plastic) * material_.stiffnessFactor(thetaBar);
+            sum += springs_[s].k * springs_[s].restLength * springs_[s].restLength * yieldOf(s) *
+                   yieldOf(s) * lawOf(s).energy(eta / yieldOf(s), plastic) *
+                   material_.stiffnessFactor(thetaBar);
         }
         return sum;
     }

@@ -149,6 +149,16 @@ private:
     double stiffening_ = 1.0;
     double criticalStrain_;
     std::vector<double> strength_;  ///< per spring, from material maps; empty: all 1
+    // Law maps, per spring, its ends' mean factor; empty: all 1. The spring runs eq. 20 in
+    // units of its own eta0 (k f(eta / k), as the bonds: sim/PeridynamicBonds.h) with its own
+    // beta.
+    std::vector<double> yield_, softening_;
+    double yieldOf(int s) const { return yield_.empty() ? 1.0 : yield_[s]; }
+    BondLaw lawOf(int s) const {
+        BondLaw law = law_;
+        if (!softening_.empty()) law.softening *= softening_[s];
+        return law;
+    }
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;
     // Per particle, its springs (signed: +s+1 when it is end i, -(s+1) when end j), so each

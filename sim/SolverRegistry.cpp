@@ -32,13 +32,13 @@ constexpr std::array kSolvers{
     SolverEntry{"mass_spring_vg",
                 "one spring per triangle edge, Van Gelder's k (eq. 1)",
                 "mass-spring paper",
-                {true, true, true, false, false, true},
+                {true, true, true, false, false, true, false, true},
                 &MassSpring::makeVanGelder},
     SolverEntry{"mass_spring_tp",
                 "two-parameter springs: fixed Q (eq. 12) x variable q (eq. 14), from the sides' "
                 "and heights' strains",
                 "mass-spring paper",
-                {true, true, true, false, false, true},
+                {true, true, true, false, false, true, false, true},
                 &MassSpring::makeTwoParameter},
     SolverEntry{"sph",
                 "kernel-corrected total-Lagrangian SPH (rest neighbours within 2 dx), St. "

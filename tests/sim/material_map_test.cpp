@@ -260,7 +260,7 @@ TEST(MaterialMap, ADensityMapIsTheDiffusionsThermalMassToo) {
 // A yield_strain map halves eta0 on x > 0: stretched to 0.8 eta0 everywhere, only that half
 // yields and softens (eq. 27's gamma < 1); the other stays whole. Without the map nothing yields.
 TEST(MaterialMap, AYieldStrainMapYieldsOnlyWhereItLowersTheYield) {
-    for (const char* solver : {"peridynamic", "fem_cst", "mpm"})
+    for (const char* solver : {"peridynamic", "fem_cst", "mpm", "mass_spring_vg", "mass_spring_tp"})
         for (const bool mapped : {true, false}) {
             SCOPED_TRACE(solver);
             MembraneParams p = sheet();
@@ -302,8 +302,9 @@ TEST(MaterialMap, AYieldStrainMapYieldsOnlyWhereItLowersTheYield) {
     MaterialMap weak = region(MapShape::Box, 0.5);
     weak.property = MappedProperty::YieldStrain;
     fem.materialMaps = {weak};
-    EXPECT_EQ(unsupportedFeatures(solverEntry("mass_spring_vg"), fem),
-              "a material map of yield_strain or softening");
+    EXPECT_EQ(unsupportedFeatures(solverEntry("sph"), fem),
+              "a bond law other than linear and a material map of yield_strain or softening");
+    EXPECT_EQ(unsupportedFeatures(solverEntry("mass_spring_tp"), fem), "");
     EXPECT_EQ(unsupportedFeatures(solverEntry("fem_cst"), fem), "");
     EXPECT_EQ(unsupportedFeatures(solverEntry("peridynamic"), fem), "");
 }
@@ -311,7 +312,8 @@ TEST(MaterialMap, AYieldStrainMapYieldsOnlyWhereItLowersTheYield) {
 // A softening map makes eq. 20 decay four times as fast on x > 0: stretched to 2 eta0, the
 // bonds (or elements) there keep exp(-4) of their strength against exp(-1) on x < 0.
 TEST(MaterialMap, ASofteningMapSoftensOnlyWhereItNames) {
-    for (const char* solver : {"peridynamic", "fem_cst", "mpm"}) {
+    for (const char* solver :
+         {"peridynamic", "fem_cst", "mpm", "mass_spring_vg", "mass_spring_tp"}) {
         SCOPED_TRACE(solver);
         MembraneParams p = sheet();
         p.solver = solver;

@@ -71,7 +71,57 @@ sim::GreyImage readImage(const TableReader& t, const Scene& scene) {
     return grey;
 }
 
-sim::MaterialMap readMap(const TableReader& t, const Scene& scene) {
+/// The smallest and largest factor a map gives, and the key that sets them.
+struct FactorRange {
+    double low, high;
+    std::string_view key;
+};
+
+FactorRange factorRange(const sim::MaterialMap& m) {
+    switch (m.shape) {
+        case sim::MapShape::Noise:
+            return {1.0 - m.amplitude, 1.0 + m.amplitude, "amplitude"};
+        case sim::MapShape::Image:
+            return {m.low, m.high, "low"};
+        default:  // 1 outside the region
+            return {std::min(1.0, m.factor), std::max(1.0, m.factor), "factor"};
+    }
+}
+
+/// A map of the bond law's parameters needs that law, and a power-law exponent map must keep n
+/// in the schema's (1, 100] with the maps before it (they multiply).
+void checkLawMap(const TableReader& t, const sim::MaterialMap& m,
+                 const sim::MaterialParams& material, double& exponentLow, double& exponentHigh) {
+    using P = sim::MappedProperty;
+    const std::string name = "\"" + sim::mappedPropertyName(m.property) + "\"";
+    const bool yieldMap = m.property == P::YieldStrain || m.property == P::Softening;
+    const bool powerMap = m.property == P::PowerRatio || m.property == P::PowerExponent;
+    if (yieldMap && material.law != sim::BondLawKind::Elastoplastic) {
+        t.fail("property", "a material with law = \"elastoplastic\"", name,
+               "Give [material] law = \"elastoplastic\", or map another property.");
+    }
+    if (powerMap && material.law != sim::BondLawKind::PowerLaw) {
+        t.fail("property", "a material with law = \"power_law\"", name,
+               "Give [material] law = \"power_law\", or map another property.");
+    }
+    if (m.property == P::PowerRatio && material.powerLawRatio == 0.0) {
+        t.fail("property", "a material with power_ratio below 0 (a factor on 0 changes nothing)",
+               name, "Give [material] power_ratio, e.g. -0.1, or map another property.");
+    }
+    if (m.property != P::PowerExponent) return;
+    const FactorRange range = factorRange(m);
+    exponentLow *= range.low, exponentHigh *= range.high;
+    const double n = material.powerLawExponent;
+    if (!(n * exponentLow > 1.0) || !(n * exponentHigh <= 100.0)) {
+        t.fail(range.key, "factors that keep power_exponent in (1, 100]",
+               "n from " + scene::formatNumber(n * exponentLow) + " to " +
+                   scene::formatNumber(n * exponentHigh),
+               "Narrow the map's factors, or change [material] power_exponent.");
+    }
+}
+
+sim::MaterialMap readMap(const TableReader& t, const Scene& scene, double& exponentLow,
+                         double& exponentHigh) {
     sim::MaterialMap m;
     if (!t.has("property")) t.missing("property", scene::oneOf(names::kMappedProperties));
     if (!t.has("shape")) t.missing("shape", scene::oneOf(names::kMapShapes));
@@ -91,13 +141,7 @@ sim::MaterialMap readMap(const TableReader& t, const Scene& scene) {
     m.low = t.number("low").value_or(m.low);
     m.high = t.number("high").value_or(m.high);
     if (m.shape == sim::MapShape::Image) m.image = readImage(t, scene);
-    const bool lawMap = m.property == sim::MappedProperty::YieldStrain ||
-                        m.property == sim::MappedProperty::Softening;
-    if (lawMap && scene.sim.material.law != sim::BondLawKind::Elastoplastic) {
-        t.fail("property", "a material with law = \"elastoplastic\"",
-               "\"" + sim::mappedPropertyName(m.property) + "\"",
-               "Give [material] law = \"elastoplastic\", or map another property.");
-    }
+    checkLawMap(t, m, scene.sim.material, exponentLow, exponentHigh);
     if (m.property == sim::MappedProperty::FractureEnergy && !scene.sim.material.fractureEnergy) {
         t.fail("property", "a material that breaks (fracture_energy is \"none\")",
                "\"fracture_energy\"", "Give [material] fracture_energy, or map another property.");
@@ -109,8 +153,9 @@ sim::MaterialMap readMap(const TableReader& t, const Scene& scene) {
 
 void readMaterialMaps(const TableReader& root, Scene& scene) {
     const TableReader material = root.section("material");
+    double exponentLow = 1.0, exponentHigh = 1.0;  // the product of the exponent maps' factors
     for (const TableReader& entry : material.entries("map"))
-        scene.sim.materialMaps.push_back(readMap(entry, scene));
+        scene.sim.materialMaps.push_back(readMap(entry, scene, exponentLow, exponentHigh));
 }
 
 }  // namespace rend

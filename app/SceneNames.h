@@ -19,7 +19,8 @@ inline constexpr std::string_view kLaws[] = {"linear", "power_law", "elastoplast
 inline constexpr std::string_view kCriticalStretches[] = {"calibrated", "paper", "preview",
                                                           "midway"};
 inline constexpr std::string_view kMappedProperties[] = {
-    "E", "fracture_energy", "density", "yield_strain", "softening"};  // sim::MappedProperty
+    "E",         "fracture_energy", "density",       "yield_strain",
+    "softening", "power_ratio",     "power_exponent"};  // sim::MappedProperty
 inline constexpr std::string_view kMapShapes[] = {"box", "disc", "polygon", "noise",
                                                   "image"};  // sim::MapShape
 inline constexpr std::string_view kBoundaryTypes[] = {"velocity", "pinned"};

@@ -73,6 +73,18 @@ struct BondLaw {
 
     double stiffness() const { return c; }
 
+    /// This law with a material map's factors on eq. 20's beta and on the power law's c*/c and
+    /// n (eq. 19, issue 15). c is kept, and cp follows, so the small-strain stiffness stays c:
+    /// such a map changes only how the sheet yields or stiffens, never its E.
+    BondLaw scaled(double softeningFactor, double ratioFactor, double exponentFactor) const {
+        BondLaw law = *this;
+        law.softening *= softeningFactor;
+        law.powerCStar *= ratioFactor;
+        law.powerN *= exponentFactor;
+        law.powerC = (c - law.powerCStar * law.powerN * (law.powerN - 1.0)) / 8.0;
+        return law;
+    }
+
     /// The most compression the power law is evaluated at (a bond squashed to 5% of its
     /// length): beyond it the push is held, and the explicit step's look-ahead stops there too.
     static constexpr double kMostCompression = -0.95;

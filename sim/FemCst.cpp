@@ -148,16 +148,16 @@ std::unique_ptr<Solver> FemCst::make(const SolverSetUp& s) {
 
 void FemCst::applyMaterialMaps(std::span<const MaterialMap> maps,
                                std::span<const Eigen::Vector3d> rest) {
-    if (mapsProperty(maps, MappedProperty::Softening)) {
-        const std::vector<double> b = materialFactors(MappedProperty::Softening, maps, rest);
+    double Element::*factors[] = {&Element::yield, &Element::softening, &Element::powerRatio,
+                                  &Element::powerExponent};  // in kLawProperties' order
+    for (int k = 0; k < 4; ++k) {
+        if (!mapsProperty(maps, kLawProperties[k])) continue;
+        const std::vector<double> f = materialFactors(kLawProperties[k], maps, rest);
         for (Element& element : elements_)
-            element.softening = (b[element.v[0]] + b[element.v[1]] + b[element.v[2]]) / 3.0;
+            element.*factors[k] = (f[element.v[0]] + f[element.v[1]] + f[element.v[2]]) / 3.0;
     }
-    if (mapsProperty(maps, MappedProperty::YieldStrain)) {
-        const std::vector<double> y = materialFactors(MappedProperty::YieldStrain, maps, rest);
-        for (Element& element : elements_)
-            element.yield = (y[element.v[0]] + y[element.v[1]] + y[element.v[2]]) / 3.0;
-    }
+    ownPowerLaws_ = mapsProperty(maps, MappedProperty::PowerRatio) ||
+                    mapsProperty(maps, MappedProperty::PowerExponent);
     if (!mapsProperty(maps, MappedProperty::YoungsModulus) &&
         !mapsProperty(maps, MappedProperty::FractureEnergy))
         return;
@@ -313,7 +313,8 @@ Eigen::Matrix2d FemCst::nonlinearStress(int t, const Eigen::Matrix<double, 3, 2>
     Eigen::Matrix2d biot;  // Biot stress in U's eigenbasis
     if (law_.kind == BondLawKind::PowerLaw) {
         // W = 1/2 q^T D q with D = [[lambda* + 2 mu, lambda*], [lambda*, lambda* + 2 mu]].
-        const PowerShape a = powerShape(law_, e[0]), b = powerShape(law_, e[1]);
+        const BondLaw law = ownPowerLaws_ ? lawOf(t) : law_;
+        const PowerShape a = powerShape(law, e[0]), b = powerShape(law, e[1]);
         const double da = (lambda_ + 2.0 * mu_) * a.q + lambda_ * b.q;
         const double db = lambda_ * a.q + (lambda_ + 2.0 * mu_) * b.q;
         biot << da * a.slope, 0.0, 0.0, db * b.slope;
@@ -429,9 +430,18 @@ void FemCst::advance(const StepState& s, Workspace& work, std::vector<Eigen::Vec
     forces(s, work, force);
     // The power law's tangent grows as s^-4 in compression (eq. 19); the others do not stiffen.
     const double lowest = static_cast<FemWorkspace&>(work).lowest;
-    stiffening_ = law_.kind == BondLawKind::PowerLaw
-                      ? std::max(1.0, law_.powerLawStiffening(clampCompression(lowest)))
-                      : 1.0;
+    stiffening_ = law_.kind == BondLawKind::PowerLaw ? stiffestAt(clampCompression(lowest)) : 1.0;
+}
+
+double FemCst::stiffestAt(double strain) const {
+    if (!(strain < 0.0)) return 1.0;
+    if (!ownPowerLaws_) return std::max(1.0, law_.powerLawStiffening(strain));
+    // With power-law maps, every element's law at the most compressed strain anywhere: a bound,
+    // since each tangent only grows as the element closes.
+    double stiffest = 1.0;
+    for (int t = 0; t < int(elements_.size()); ++t)
+        stiffest = std::max(stiffest, lawOf(t).powerLawStiffening(strain));
+    return stiffest;
 }
 
 double FemCst::strengthLeft(int t) const {

@@ -101,8 +101,10 @@ private:
         std::array<int, 3> across;    ///< element across side s (opposite vertex s), or -1
         double stiffness = 1.0;       ///< E over the material's: its corners' mean (maps)
         double strength = 1.0;        ///< the critical strain's factor, sqrt(G_f / E) (maps)
-        double yield = 1.0;      ///< eta0 over the law's: its corners' mean (yield_strain maps)
-        double softening = 1.0;  ///< beta over the law's: its corners' mean (softening maps)
+        double yield = 1.0;          ///< eta0 over the law's: its corners' mean (yield_strain maps)
+        double softening = 1.0;      ///< beta over the law's: its corners' mean (softening maps)
+        double powerRatio = 1.0;     ///< c*/c over the law's (power_ratio maps)
+        double powerExponent = 1.0;  ///< n over the law's (power_exponent maps)
     };
     void findNeighbours();
     /// Issue 15's material maps: each element's E and critical strain from its corners'.
@@ -150,12 +152,15 @@ private:
     /// the thread count) and clears the flags; see erode() for `breakSides`.
     void erodeFlagged(bool breakSides);
 
-    /// Element t's law: the material's, with its own beta where a softening map sets one.
+    /// Element t's law: the material's, with its own beta, c*/c and n where maps set them.
     BondLaw lawOf(int t) const {
-        BondLaw law = law_;
-        law.softening *= elements_[t].softening;
-        return law;
+        const Element& e = elements_[t];
+        return law_.scaled(e.softening, e.powerRatio, e.powerExponent);
     }
+    bool ownPowerLaws_ = false;  ///< whether power-law maps gave elements laws of their own
+
+    /// The power law's largest tangent over c among the elements at a principal strain.
+    double stiffestAt(double strain) const;
 
     std::vector<Element> elements_;
     // Gather layout: the corners each particle belongs to (element * 3 + corner), so each

@@ -70,10 +70,13 @@ MassSpring::MassSpring(const Lattice& lattice, SpringModel model, const Material
         for (const Spring& s : springs_)
             strength_.push_back(std::sqrt((g[s.i] + g[s.j]) / (eFactor[s.i] + eFactor[s.j])));
     }
-    for (const MappedProperty property : {MappedProperty::YieldStrain, MappedProperty::Softening}) {
+    std::vector<double>* factors[] = {&yield_, &softening_, &ratio_,
+                                      &exponent_};  // in kLawProperties' order
+    for (int k = 0; k < 4; ++k) {
+        const MappedProperty property = kLawProperties[k];
         if (!mapsProperty(maps, property)) continue;
         const std::vector<double> f = materialFactors(property, maps, p);
-        std::vector<double>& factor = property == MappedProperty::YieldStrain ? yield_ : softening_;
+        std::vector<double>& factor = *factors[k];
         for (const Spring& s : springs_) factor.push_back(0.5 * (f[s.i] + f[s.j]));
     }
     bindOwn({}, n, lattice.triangles);
@@ -125,7 +128,7 @@ void MassSpring::advance(const StepState& state, Workspace& work,
                          std::vector<Eigen::Vector3d>& force) {
     fracture(state, work);
     if (law_.kind == BondLawKind::PowerLaw)  // the clamp is the peridynamic loop's
-        stiffening_ = std::max(1.0, law_.powerLawStiffening(clampCompression(lowestStrain(state))));
+        stiffening_ = stiffestSpring(state);
     forces(state, work, force);
 }
 
@@ -136,13 +139,14 @@ void MassSpring::reportStrength(DamageState& damage) const {
             damage.weaken(b, lawOf(s).strengthLeft(plastic_[s]));  // eq. 27's gamma of the side
 }
 
-double MassSpring::lowestStrain(const StepState& state) const {
+double MassSpring::stiffestSpring(const StepState& state) const {
     const auto& x = state.x;
     const auto& v = state.v;
     const double dt = state.dt;
-    double lowest = 0.0;
+    const bool own = ownLaws();
+    double stiffest = 1.0;
     const int count = int(springs_.size());
-#pragma omp parallel for schedule(static) reduction(min : lowest) if (count >= kParallelThreshold)
+#pragma omp parallel for schedule(static) reduction(max : stiffest) if (count >= kParallelThreshold)
     for (int s = 0; s < count; ++s) {
         if (!springAlive(s)) continue;
         double thetaBar;
@@ -151,9 +155,11 @@ double MassSpring::lowestStrain(const StepState& state) const {
         const Spring& sp = springs_[s];
         const Eigen::Vector3d r = x[sp.j] - x[sp.i];
         const double rate = r.dot(v[sp.j] - v[sp.i]) / (r.norm() * sp.restLength);
-        lowest = std::min(lowest, eta + std::min(0.0, dt * rate));
+        const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
+        stiffest = std::max(
+            stiffest, own ? lawOf(s).powerLawStiffening(ahead) : law_.powerLawStiffening(ahead));
     }
-    return lowest;
+    return stiffest;
 }
 
 double MassSpring::mechanicalStrain(int s, const StepState& state, double& thetaBar) const {
@@ -288,7 +294,8 @@ void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& w
             const double eta = mechanicalStrain(s, state, thetaBar);
             // Below 1e-6 the secant is 1 to within phi''(0) 1e-6: a part in a million of a
             // tension that is itself a millionth of the stiffness.
-            if (std::abs(eta) > 1e-6) tension[s] *= law_.forceAs<K>(eta) / eta;
+            if (std::abs(eta) > 1e-6)
+                tension[s] *= (ownLaws() ? lawOf(s).forceAs<K>(eta) : law_.forceAs<K>(eta)) / eta;
         }
     }
 }

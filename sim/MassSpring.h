@@ -128,7 +128,9 @@ private:
 
     /// The most compressed spring's strain looked ahead by dt along its rate; 0 when nothing is
     /// in compression.
-    double lowestStrain(const StepState& state) const;
+    /// The power law's largest tangent over c among the compressed springs, each where it will
+    /// be in dt if it keeps closing (1 when none stiffens).
+    double stiffestSpring(const StepState& state) const;
 
     /// Spring s is the DamageState's edge s (both are numbered over the triangles' sides in
     /// order). A broken spring carries nothing; a two-parameter triangle with a broken side is
@@ -151,13 +153,13 @@ private:
     std::vector<double> strength_;  ///< per spring, from material maps; empty: all 1
     // Law maps, per spring, its ends' mean factor; empty: all 1. The spring runs eq. 20 in
     // units of its own eta0 (k f(eta / k), as the bonds: sim/PeridynamicBonds.h) with its own
-    // beta.
-    std::vector<double> yield_, softening_;
+    // beta, c*/c and n.
+    std::vector<double> yield_, softening_, ratio_, exponent_;
     double yieldOf(int s) const { return yield_.empty() ? 1.0 : yield_[s]; }
+    bool ownLaws() const { return !softening_.empty() || !ratio_.empty() || !exponent_.empty(); }
     BondLaw lawOf(int s) const {
-        BondLaw law = law_;
-        if (!softening_.empty()) law.softening *= softening_[s];
-        return law;
+        auto at = [s](const std::vector<double>& f) { return f.empty() ? 1.0 : f[s]; };
+        return law_.scaled(at(softening_), at(ratio_), at(exponent_));
     }
     std::vector<Spring> springs_;
     std::vector<Triangle> triangles_;

@@ -102,6 +102,10 @@ std::string mappedPropertyName(MappedProperty property) {
             return "yield_strain";
         case MappedProperty::Softening:
             return "softening";
+        case MappedProperty::PowerRatio:
+            return "power_ratio";
+        case MappedProperty::PowerExponent:
+            return "power_exponent";
     }
     return "";
 }
@@ -121,6 +125,11 @@ double valueNoise(const Eigen::Vector2d& p, int octaves, std::uint64_t seed) {
 bool mapsProperty(std::span<const MaterialMap> maps, MappedProperty property) {
     return std::any_of(maps.begin(), maps.end(),
                        [&](const MaterialMap& m) { return m.property == property; });
+}
+
+bool mapsLaw(std::span<const MaterialMap> maps) {
+    return std::any_of(std::begin(kLawProperties), std::end(kLawProperties),
+                       [&](MappedProperty p) { return mapsProperty(maps, p); });
 }
 
 std::vector<double> materialFactors(MappedProperty property, std::span<const MaterialMap> maps,

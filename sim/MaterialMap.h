@@ -15,7 +15,15 @@
 
 namespace rend::sim {
 
-enum class MappedProperty { YoungsModulus, FractureEnergy, Density, YieldStrain, Softening };
+enum class MappedProperty {
+    YoungsModulus,
+    FractureEnergy,
+    Density,
+    YieldStrain,
+    Softening,
+    PowerRatio,
+    PowerExponent
+};
 enum class MapShape { Box, Disc, Polygon, Noise, Image };
 
 /// Grey levels in [0, 1], row 0 at the top (at the sheet's largest rest y), as images are stored.
@@ -44,7 +52,7 @@ struct MaterialMap {
 };
 
 /// The property's name as scenes spell it: "E", "fracture_energy", "density", "yield_strain",
-/// "softening".
+/// "softening", "power_ratio", "power_exponent".
 std::string mappedPropertyName(MappedProperty property);
 
 /// Each particle's factor for `property`: the product of the maps that name it, 1 where none
@@ -54,6 +62,15 @@ std::vector<double> materialFactors(MappedProperty property, std::span<const Mat
 
 /// Whether any map names `property`.
 bool mapsProperty(std::span<const MaterialMap> maps, MappedProperty property);
+
+/// The maps of the bond law's own parameters (eqs. 19 and 20), which every solver but the SPH
+/// applies bond by bond (spring, element): yield_strain, softening, power_ratio, power_exponent.
+inline constexpr MappedProperty kLawProperties[] = {
+    MappedProperty::YieldStrain, MappedProperty::Softening, MappedProperty::PowerRatio,
+    MappedProperty::PowerExponent};
+
+/// Whether any map names one of kLawProperties.
+bool mapsLaw(std::span<const MaterialMap> maps);
 
 /// The value noise of the noise maps, in [-1, 1], at p in cells (octave 1).
 double valueNoise(const Eigen::Vector2d& p, int octaves, std::uint64_t seed);

@@ -62,7 +62,8 @@ std::unique_ptr<Solver> Mpm::make(const SolverSetUp& s) {
 void Mpm::findMaterialBoundaries(std::span<const MaterialMap> maps) {
     for (const MappedProperty property :
          {MappedProperty::YoungsModulus, MappedProperty::FractureEnergy, MappedProperty::Density,
-          MappedProperty::YieldStrain, MappedProperty::Softening}) {
+          MappedProperty::YieldStrain, MappedProperty::Softening, MappedProperty::PowerRatio,
+          MappedProperty::PowerExponent}) {
         if (!mapsProperty(maps, property)) continue;
         const std::vector<double> f = materialFactors(property, maps, restPositions_);
         for (const auto& [i, j] : edges_)

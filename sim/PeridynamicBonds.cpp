@@ -55,11 +55,13 @@ void PeridynamicBonds::computeBondScales(const MembraneParams& params, double pa
 }
 
 void PeridynamicBonds::applyYieldMap(std::span<const MaterialMap> maps) {
-    for (const MappedProperty property : {MappedProperty::YieldStrain, MappedProperty::Softening}) {
+    std::vector<double>* factors[] = {&yieldFactor_, &softeningFactor_, &ratioFactor_,
+                                      &exponentFactor_};  // in kLawProperties' order
+    for (int p = 0; p < 4; ++p) {
+        const MappedProperty property = kLawProperties[p];
         if (!mapsProperty(maps, property)) continue;
         const std::vector<double> y = materialFactors(property, maps, rest_);
-        std::vector<double>& factor =
-            property == MappedProperty::YieldStrain ? yieldFactor_ : softeningFactor_;
+        std::vector<double>& factor = *factors[p];
         factor.resize(bonds_.directedCount());
         for (int i = 0; i < bonds_.particleCount(); ++i)
             for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
@@ -191,7 +193,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const double* bondScale = bondScale_.data();
     const double* stretchFactor = stretchFactor_.empty() ? nullptr : stretchFactor_.data();
     const double* yieldFactor = yieldFactor_.empty() ? nullptr : yieldFactor_.data();
-    const bool ownSoftening = !softeningFactor_.empty();
+    const bool ownLaws = this->ownLaws();
     const std::uint8_t* alive = damage_->bondAlive().data();
     std::uint8_t* proposed = updates.proposed;
     PlasticState* plastic = updates.plastic;
@@ -238,20 +240,18 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
             if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
                 if (eta < 0.0) {  // its tangent where it will be in dt, if it closes
                     const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
-                    double tangent =
-                        law_.powerLawStiffening(clampCompression(eta + std::min(0.0, dt * rate)));
+                    const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
+                    double tangent = ownLaws ? lawOf(b).powerLawStiffening(ahead)
+                                             : law_.powerLawStiffening(ahead);
                     // A dissolved bond (theta past 1 / stiffness_loss) is squashed by its own
                     // swelling, yet carries no force: only the stiffness it has counts.
                     if constexpr (kTheta) tangent *= material_.stiffnessFactor(thetaBar);
                     stiffest = std::max(stiffest, tangent);
                 }
             }
-            double f;
-            if constexpr (kLaw == BondLawKind::Elastoplastic)
-                f = yield *
-                    (ownSoftening ? lawOf(b) : law_).template forceAs<kLaw>(eta / yield, state);
-            else
-                f = law_.forceAs<kLaw>(eta, state);
+            // A copy of the law only where maps give this bond its own.
+            double f = ownLaws ? yield * lawOf(b).template forceAs<kLaw>(eta / yield, state)
+                               : yield * law_.template forceAs<kLaw>(eta / yield, state);
             if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
             sum += (bondScale[b] * f / length) * r;
         }

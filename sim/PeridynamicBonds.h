@@ -93,12 +93,17 @@ private:
     std::vector<PlasticState> plastic_;    ///< per bond; empty unless the law is elastoplastic
     std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
     std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
+    std::vector<double> ratioFactor_;      ///< per bond, c*/c over the law's (maps); empty: all 1
+    std::vector<double> exponentFactor_;   ///< per bond, n over the law's (maps); empty: all 1
     double yieldOf(int b) const { return yieldFactor_.empty() ? 1.0 : yieldFactor_[b]; }
-    /// Bond b's law: the material's, with its own beta where a softening map sets one.
+    /// Whether some bond has a law of its own (softening or power-law maps).
+    bool ownLaws() const {
+        return !softeningFactor_.empty() || !ratioFactor_.empty() || !exponentFactor_.empty();
+    }
+    /// Bond b's law: the material's, with its own beta, c*/c and n where maps set them.
     BondLaw lawOf(int b) const {
-        BondLaw law = law_;
-        if (!softeningFactor_.empty()) law.softening *= softeningFactor_[b];
-        return law;
+        auto at = [b](const std::vector<double>& f) { return f.empty() ? 1.0 : f[b]; };
+        return law_.scaled(at(softeningFactor_), at(ratioFactor_), at(exponentFactor_));
     }
     double stiffening_ = 1.0;  ///< the most compressed bond's, over c (advance() only)
 };

@@ -101,9 +101,10 @@ std::string unsupportedFeatures(const SolverEntry& solver, const MembraneParams&
                               mapsProperty(params.materialMaps, MappedProperty::FractureEnergy)))
         wanted.push_back("a material map of E or fracture_energy");
     if (params.remesh.every > 0 && !can.remesh) wanted.push_back("remesh");
-    if (!can.lawMaps && (mapsProperty(params.materialMaps, MappedProperty::YieldStrain) ||
-                         mapsProperty(params.materialMaps, MappedProperty::Softening)))
-        wanted.push_back("a material map of yield_strain or softening");
+    if (!can.lawMaps && mapsLaw(params.materialMaps))
+        wanted.push_back(
+            "a material map of the bond law (yield_strain, softening, power_ratio, "
+            "power_exponent)");
     if (params.remesh.every > 0 && params.sheet.outline == Outline::Sphere)
         wanted.push_back("remesh on a sphere (it remeshes in the flat rest plane)");
     return joined(wanted, " and ");
@@ -125,7 +126,8 @@ std::string solverTableMarkdown() {
         if (can.fracture) takes.push_back("fracture");
         if (can.sphere) takes.push_back("sphere");
         if (can.materialMaps) takes.push_back("material maps");
-        if (can.lawMaps) takes.push_back("yield_strain and softening maps");
+        if (can.lawMaps)
+            takes.push_back("bond-law maps (yield_strain, softening, power_ratio, power_exponent)");
         if (can.remesh) takes.push_back("`remesh`");
         if (can.paperCriticalStretch) takes.push_back("`critical_stretch = \"paper\"`");
         if (can.surfaceCorrection) takes.push_back("`surface_correction`");

@@ -96,7 +96,7 @@ TEST(MaterialMapKeys, EveryMistakeIsRefusedAtItsLocation) {
     expectRefused("[[material.map]]\nshape = \"box\"\n", 10, "property is missing");
     expectRefused("[[material.map]]\nproperty = \"stiffness\"\nshape = \"box\"\n", 11,
                   "expected one of \"E\", \"fracture_energy\", \"density\", \"yield_strain\", "
-                  "\"softening\", found \"stiffness\"");
+                  "\"softening\", \"power_ratio\", \"power_exponent\", found \"stiffness\"");
     expectRefused(
         "[[material.map]]\nproperty = \"E\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\n"
         "factor = 2.0\n",
@@ -141,6 +141,39 @@ TEST(MaterialMapKeys, AFractureEnergyMapNeedsABreakingMaterialAndEverySolverTake
     EXPECT_NE(linear.find("law = \"elastoplastic\""), std::string::npos) << linear;
     EXPECT_EQ(refusal(yield, {"material.law=elastoplastic"}), "");
     const std::string sph = refusal(yield, {"material.law=elastoplastic", "solver=sph"});
-    EXPECT_NE(sph.find("a material map of yield_strain or softening"), std::string::npos) << sph;
+    EXPECT_NE(sph.find("a material map of the bond law (yield_strain, softening, power_ratio, "
+                       "power_exponent)"),
+              std::string::npos)
+        << sph;
     EXPECT_EQ(refusal(yield, {"material.law=elastoplastic", "solver=mass_spring_vg"}), "");
+}
+
+// The power law's maps: they need the power law, a c*/c to scale, and an exponent kept in the
+// schema's (1, 100] by all the exponent maps together (their factors multiply).
+TEST(MaterialMapKeys, APowerLawMapNeedsThePowerLawAndKeepsItsExponentInRange) {
+    auto map = [](const char* property, const char* factor) {
+        return std::string("[[material.map]]\nproperty = \"") + property +
+               "\"\nshape = \"disc\"\ncenter = [0.0, 0.0]\nradius = 0.1\nfactor = " + factor + "\n";
+    };
+    const std::string ratio = map("power_ratio", "2.0");
+    expectRefused(ratio, 11, "expected a material with law = \"power_law\"");
+    const std::string zero = refusal(ratio, {"material.law=power_law"});
+    EXPECT_NE(zero.find("power_ratio below 0"), std::string::npos) << zero;
+    EXPECT_EQ(refusal(ratio, {"material.law=power_law", "material.power_ratio=-0.1"}), "");
+    const std::vector<std::string> power = {"material.law=power_law"};
+    EXPECT_EQ(refusal(map("power_exponent", "1.5"), power), "");
+    // n = 4 by default: 0.2 gives 0.8, and two maps of 6 give 144.
+    const std::string low = refusal(map("power_exponent", "0.2"), power);
+    EXPECT_NE(low.find("scene.toml:15:10: error: material.map.0.factor: expected factors that "
+                       "keep power_exponent in (1, 100], found n from 0.8 to 4"),
+              std::string::npos)
+        << low;
+    const std::string twice =
+        refusal(map("power_exponent", "6.0") + "\n" + map("power_exponent", "6.0"), power);
+    EXPECT_NE(twice.find("scene.toml:22:10: error: material.map.1.factor"), std::string::npos)
+        << twice;
+    EXPECT_NE(twice.find("found n from 4 to 144"), std::string::npos) << twice;
+    const std::string sph =
+        refusal(map("power_exponent", "1.5"), {"material.law=power_law", "solver=sph"});
+    EXPECT_NE(sph.find("a material map of the bond law"), std::string::npos) << sph;
 }

@@ -303,7 +303,8 @@ TEST(MaterialMap, AYieldStrainMapYieldsOnlyWhereItLowersTheYield) {
     weak.property = MappedProperty::YieldStrain;
     fem.materialMaps = {weak};
     EXPECT_EQ(unsupportedFeatures(solverEntry("sph"), fem),
-              "a bond law other than linear and a material map of yield_strain or softening");
+              "a bond law other than linear and a material map of the bond law (yield_strain, "
+              "softening, power_ratio, power_exponent)");
     EXPECT_EQ(unsupportedFeatures(solverEntry("mass_spring_tp"), fem), "");
     EXPECT_EQ(unsupportedFeatures(solverEntry("fem_cst"), fem), "");
     EXPECT_EQ(unsupportedFeatures(solverEntry("peridynamic"), fem), "");
@@ -346,4 +347,44 @@ TEST(MaterialMap, ASofteningMapSoftensOnlyWhereItNames) {
         EXPECT_GT(left, 0.2);
         EXPECT_LT(right, 0.1);
     }
+}
+
+// A power-law map changes the law's shape only: eq. 19 keeps its small-strain stiffness c, so
+// the mapped sheet stores the plain one's energy at a small stretch and not at a large one, and
+// a map over half the sheet changes about half as much as one over all of it.
+TEST(MaterialMap, APowerLawMapChangesOnlyTheLargeStrainShape) {
+    for (const MappedProperty property :
+         {MappedProperty::PowerRatio, MappedProperty::PowerExponent})
+        for (const char* solver :
+             {"peridynamic", "fem_cst", "mpm", "mass_spring_vg", "mass_spring_tp"}) {
+            SCOPED_TRACE(std::string(solver) + " " + mappedPropertyName(property));
+            auto energyAt = [&](double strain, double xMax) {
+                MembraneParams p = sheet();
+                p.solver = solver;
+                p.material.fractureEnergy.reset();
+                p.material.law = BondLawKind::PowerLaw;
+                p.material.powerLawRatio = -0.05;
+                p.material.powerLawExponent = 4.0;
+                if (xMax > -1.0) {
+                    MaterialMap map = region(MapShape::Box, 1.5);
+                    map.property = property;
+                    map.min = {-1.0, -1.0};
+                    map.max = {xMax, 1.0};
+                    p.materialMaps = {map};
+                }
+                Membrane m(p);
+                for (int i = 0; i < m.particleCount(); ++i)
+                    m.positions()[i] = (1.0 + strain) * m.restPositions()[i];
+                return m.strainEnergy();
+            };
+            const double small = 1e-5, large = 0.2;
+            EXPECT_NEAR(energyAt(small, 1.0) / energyAt(small, -2.0), 1.0, 1e-3);
+            const double plain = energyAt(large, -2.0), all = energyAt(large, 1.0);
+            const double half = energyAt(large, 0.0);
+            std::printf("%s %s at 20%%: all mapped / plain %.4f, half share %.3f\n", solver,
+                        mappedPropertyName(property).c_str(), all / plain,
+                        (half - plain) / (all - plain));
+            EXPECT_GT(std::abs(all / plain - 1.0), 0.05);
+            EXPECT_NEAR((half - plain) / (all - plain), 0.5, 0.1);
+        }
 }

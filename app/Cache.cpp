@@ -15,7 +15,7 @@ namespace rend {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'E', 'N', 'D', 'C', 'A', 'C', 'H'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;  // 2: the particle level set (issue 15)
 constexpr std::size_t kHeaderBytes = 64;
 constexpr std::size_t kShuffle = 8;
 

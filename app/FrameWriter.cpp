@@ -49,6 +49,7 @@ const render::Mesh& asMesh(const render::Geometry& geometry, render::Mesh& scrat
 
 struct FrameWriter::Parts {
     std::unique_ptr<render::LatticeSurface> lattice;
+    std::unique_ptr<render::LatticeSurface> levelSet;  ///< particle_level_set
     std::unique_ptr<render::SplatSurface> splat;
     std::unique_ptr<render::VdbSurface> vdb;
     double exportVoxel = 0.0;  ///< the exported volume's, resolved on its first frame
@@ -92,11 +93,23 @@ render::Geometry FrameWriter::buildSurface(const sim::FrameView& view) {
         case render::SurfaceKind::Vdb:
             if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
             return p.vdb->build(view, scene_.render);
+        case render::SurfaceKind::ParticleLevelSet:
         case render::SurfaceKind::Lattice:
             break;
     }
+    return meshSurface(view).build(view, scene_.render);
+}
+
+render::LatticeSurface& FrameWriter::meshSurface(const sim::FrameView& view) {
+    Parts& p = *parts_;
+    if (scene_.render.surface == render::SurfaceKind::ParticleLevelSet) {
+        if (!p.levelSet)
+            p.levelSet = std::make_unique<render::LatticeSurface>(
+                view, render::LatticeSurface::Outline::LevelSet);
+        return *p.levelSet;
+    }
     if (!p.lattice) p.lattice = std::make_unique<render::LatticeSurface>(view);
-    return p.lattice->build(view, scene_.render);
+    return *p.lattice;
 }
 
 bool FrameWriter::writesExr() const {
@@ -119,13 +132,12 @@ render::Image FrameWriter::renderImage(const sim::FrameView& view, const render:
 const render::Mesh& FrameWriter::midSurface(const sim::FrameView& view,
                                             const render::Geometry& geometry,
                                             render::Mesh& scratch) {
-    if (scene_.render.surface == render::SurfaceKind::Lattice && scene_.render.thickness == 0.0)
-        return std::get<render::Mesh>(geometry);
-    Parts& p = *parts_;
-    if (!p.lattice) p.lattice = std::make_unique<render::LatticeSurface>(view);
+    const bool meshes = scene_.render.surface == render::SurfaceKind::Lattice ||
+                        scene_.render.surface == render::SurfaceKind::ParticleLevelSet;
+    if (meshes && scene_.render.thickness == 0.0) return std::get<render::Mesh>(geometry);
     render::RenderSettings flat = scene_.render;
     flat.thickness = 0.0;
-    scratch = p.lattice->build(view, flat);
+    scratch = meshSurface(view).build(view, flat);
     return scratch;
 }
 

@@ -13,6 +13,7 @@
 #include "render/ExrWriter.h"
 #include "render/Geometry.h"
 #include "render/Image.h"
+#include "render/LatticeSurface.h"
 #include "render/SheetVolume.h"
 #include "sim/FrameView.h"
 
@@ -42,6 +43,9 @@ public:
 
 private:
     render::Geometry buildSurface(const sim::FrameView& view);
+    /// The lattice surface, or with surface = "particle_level_set" its level-set outline; the
+    /// exports' mid-surface is the same one.
+    render::LatticeSurface& meshSurface(const sim::FrameView& view);
     /// The sheet's mid-surface (the lattice surface, not extruded) for the volume export.
     const render::Mesh& midSurface(const sim::FrameView& view, const render::Geometry& geometry,
                                    render::Mesh& scratch);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <unordered_map>
 
 #include "render/ColorMap.h"
 #include "render/RestTopology.h"
@@ -212,8 +213,9 @@ private:
     std::vector<std::uint8_t> holds_;  ///< per notch
 };
 
-LatticeSurface::LatticeSurface(const sim::FrameView& rest)
-    : triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
+LatticeSurface::LatticeSurface(const sim::FrameView& rest, Outline outline)
+    : outline_(outline),
+      triangles_(rest.restTriangles.begin(), rest.restTriangles.end()),
       edges_(restEdges(triangles_)),
       rest_(rest.restPositions.begin(), rest.restPositions.end()) {
     const std::size_t vertices = vertexCount(rest, triangles_);
@@ -231,6 +233,7 @@ LatticeSurface::LatticeSurface(const sim::FrameView& rest)
     }
     for (auto& n : restNormal_)
         n = n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::UnitZ();
+    if (outline_ == Outline::LevelSet) return;  // the level set's band draws the outline
     const auto notches = outlineNotches(triangles_, edges_, rest_);
     notchOf_.assign(notches.size(), -1);
     for (int v = 0; v < int(notches.size()); ++v) {
@@ -476,7 +479,59 @@ public:
         }
     }
 
+    /// The particle level set's outline: each kept band triangle's inside part (Phi <= 0), cut
+    /// at Phi = 0 along its particle-ghost edges, in the triangle's own (counter-clockwise)
+    /// order. Slivers (a particle on the outline, Phi = 0) are left out.
+    void addBand(const sim::FrameView& frame) {
+        const int n = static_cast<int>(frame.particleCount());
+        std::unordered_map<std::uint64_t, std::uint32_t> crossings;
+        const auto crossing = [&](int i, int g) {
+            const std::uint64_t key = (std::uint64_t(i) << 32) | std::uint32_t(g);
+            if (const auto found = crossings.find(key); found != crossings.end())
+                return found->second;
+            const double phi = frame.levelSet[i];
+            const double t = phi / (phi - frame.ghostLevelSet[g]);
+            const Eigen::Vector3d restPoint = rest(i) + t * (frame.ghostRestPositions[g] - rest(i));
+            const std::uint32_t v = add(x(i) + t * (frame.ghostPositions[g] - x(i)),
+                                        withPoint(attributes(i), i, restPoint.cast<float>()));
+            crossings.emplace(key, v);
+            return v;
+        };
+        const double sliver = 1e-6 * areaScale(frame);
+        for (std::size_t t = 0; t < frame.bandTriangles.size(); ++t) {
+            if (!frame.bandKept[t]) continue;
+            const auto& c = frame.bandTriangles[t];
+            std::array<std::uint32_t, 4> polygon;
+            int count = 0;
+            bool usable = true;
+            for (int k = 0; k < 3; ++k) {
+                const int a = c[k], b = c[(k + 1) % 3];
+                if (a >= n && !(frame.ghostLevelSet[a - n] > 0.0)) usable = false;
+                if (a < n) polygon[count++] = static_cast<std::uint32_t>(a);
+                if ((a < n) != (b < n) && count < 4)
+                    polygon[count++] = a < n ? crossing(a, b - n) : crossing(b, a - n);
+            }
+            if (!usable) continue;
+            for (int k = 1; k + 1 < count; ++k) {
+                const std::array<std::uint32_t, 3> tri = {polygon[0], polygon[k], polygon[k + 1]};
+                if (restArea(tri) > sliver) mesh_.triangles.push_back(tri);
+            }
+        }
+    }
+
 private:
+    /// The band's slivers are measured against the square of a particle's spacing.
+    static double areaScale(const sim::FrameView& frame) {
+        const double spacing = frame.bondRestLength.empty() ? 1.0 : frame.bondRestLength[0];
+        return spacing * spacing;
+    }
+
+    double restArea(const std::array<std::uint32_t, 3>& t) const {
+        const Eigen::Vector3f& a = mesh_.points[t[0]].rest;
+        return 0.5 *
+               double((mesh_.points[t[1]].rest - a).cross(mesh_.points[t[2]].rest - a).norm());
+    }
+
     /// What a vertex carries besides its position: the colour and, with a look, its layer.
     struct Attributes {
         Eigen::Vector3f colour;
@@ -676,6 +731,7 @@ Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& se
     Builder builder(*this, frame, placed, cuts, corners, settings, mesh);
     for (int t = 0; t < static_cast<int>(triangles_.size()); ++t)
         if (cuts.present[t]) builder.addPieces(t);
+    if (outline_ == Outline::LevelSet && !frame.bandTriangles.empty()) builder.addBand(frame);
     mesh.normals = smoothNormals(mesh.positions, mesh.triangles);
     if (settings.thickness > 0.0) extrude(mesh, settings.thickness);
     return mesh;

@@ -50,10 +50,23 @@ namespace rend::render {
 /// vertices and centroids follow. An intact sheet has no extra vertex.
 ///
 /// Everything per frame is a pass over the triangles and edges: O(triangles).
+///
+/// The `particle_level_set` surface (issue 15, seed 004) is this one with its outline drawn by
+/// the particle level set of FrameView (sim/ParticleLevelSet.h) instead of the notches: each
+/// kept band triangle (particles and ghosts) is cut at Phi = 0 by marching triangles, and its
+/// inside part (a triangle or a quad: the particles, and the crossing points on its
+/// particle-ghost edges) is added to the mesh, sharing the particles' vertices. A crossing
+/// vertex carries its particle's data, at the rest point of the crossing. The sheet then ends
+/// on the scene's outline (a rectangle's straight sides, a disc's circle) instead of on its
+/// outermost particles, and moves with the ghosts. Crack lips are the cut's above: their
+/// vertices lie half a rest bond from their particle, which is where the level set puts a
+/// crack's zero points. Without ghosts (a sphere) it is the lattice surface without notches.
 class LatticeSurface {
 public:
+    enum class Outline { Notches, LevelSet };
+
     /// Builds the edge maps, the triangles around each particle and the outline notches once.
-    explicit LatticeSurface(const sim::FrameView& rest);
+    explicit LatticeSurface(const sim::FrameView& rest, Outline outline = Outline::Notches);
 
     /// The frame's mesh (cut as above), smooth (area-weighted) normals per vertex, which never
     /// blend across a crack, and per-vertex colours from the settings' ColorBy, interpolated
@@ -89,6 +102,7 @@ private:
                  std::vector<int>& stack) const;
     int cornerOf(int triangle, int particle) const;
 
+    Outline outline_ = Outline::Notches;
     std::vector<std::array<int, 3>> triangles_;
     RestEdges edges_;
     std::vector<int> edgeBond_;  ///< bond ends[0] -> ends[1] of each edge, or -1

@@ -47,7 +47,7 @@ struct DirectionalLight {
 };
 
 /// Surface reconstruction of a frame (DESIGN.md, "Surfaces and rendering").
-enum class SurfaceKind { Lattice, Splat, Vdb };
+enum class SurfaceKind { Lattice, Splat, Vdb, ParticleLevelSet };
 
 /// How the path tracer shades the membrane. Conductor: rough GGX metal (aluminium foil).
 /// Film: translucent rough dielectric-like sheet (rubbery film). Translucent: thin diffuse with

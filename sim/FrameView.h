@@ -44,6 +44,20 @@ struct FrameView {
     /// surface cuts rather than drops.
     std::span<const std::uint8_t> triangleAlive;
 
+    /// Seed 004's particle level set of the outline (sim/ParticleLevelSet.h): Phi, the signed
+    /// distance along the sheet to its outline or a crack, negative inside, per particle
+    /// (-3 dx beyond the narrow band); the ghost particles outside the outline, their rest
+    /// sites, Phi and anchors (each ghost's particle); and the band's triangles, whose corners
+    /// are particles (< particleCount) and ghosts (particleCount + ghost), kept while bandKept.
+    /// All empty where the sheet has no outline (a sphere has no ghosts, only Phi).
+    std::span<const double> levelSet;
+    std::span<const Eigen::Vector3d> ghostPositions;
+    std::span<const Eigen::Vector3d> ghostRestPositions;
+    std::span<const double> ghostLevelSet;
+    std::span<const int> ghostAnchors;
+    std::span<const std::array<int, 3>> bandTriangles;
+    std::span<const std::uint8_t> bandKept;
+
     /// The scene's colliders (sim/Collider.h) and, index for index, their poses at `time`; empty
     /// without colliders. The ground plane is the render settings' own.
     std::span<const ColliderParams> colliders;

@@ -107,6 +107,70 @@ Lattice generateLattice(const SheetParams& sheet) {
     return lattice;
 }
 
+GhostBand ghostBand(const SheetParams& sheet) {
+    GhostBand band;
+    if (sheet.outline == Outline::Sphere) return band;
+    const Grid g = makeGrid(sheet);
+    constexpr int kPad = 2;  // even, so a hexagonal grid's rows keep their shifts
+    Grid wide = g;
+    wide.columns += 2 * kPad;
+    wide.rows += 2 * kPad;
+    wide.origin -= Eigen::Vector2d(kPad * sheet.dx, kPad * g.rowSpacing);
+    const auto cell = [&](int column, int row) { return std::size_t(row) * wide.columns + column; };
+    std::vector<int> particle(std::size_t(wide.columns) * wide.rows, -1);
+    int count = 0;  // generateLattice's numbering: row by row, inside the outline
+    for (int row = 0; row < g.rows; ++row)
+        for (int column = 0; column < g.columns; ++column)
+            if (insideOutline(sheet, gridPoint(g, sheet.dx, column, row)))
+                particle[cell(column + kPad, row + kPad)] = count++;
+    Lattice all;  // every grid point of the wide grid, numbered by cell
+    for (int row = 0; row < wide.rows; ++row)
+        for (int column = 0; column < wide.columns; ++column) {
+            const Eigen::Vector2d p = gridPoint(wide, sheet.dx, column, row);
+            all.positions.emplace_back(p.x(), p.y(), sheet.center.z());
+        }
+    for (int row = 0; row + 1 < wide.rows; ++row)
+        for (int column = 0; column < wide.columns; ++column)
+            triangulateCell(all, wide, column, row,
+                            [&](int c, int r) { return c < wide.columns ? int(cell(c, r)) : -1; });
+    std::vector<int> ghost(particle.size(), -1);
+    for (const auto& t : all.triangles) {
+        int particles = 0;
+        for (int c : t) particles += particle[c] >= 0;
+        if (particles == 0 || particles == 3) continue;
+        std::array<int, 3> corners;
+        for (int k = 0; k < 3; ++k) {
+            const int c = t[k];
+            if (particle[c] >= 0) {
+                corners[k] = particle[c];
+                continue;
+            }
+            if (ghost[c] < 0) {
+                ghost[c] = int(band.sites.size());
+                band.sites.push_back(all.positions[c]);
+            }
+            corners[k] = count + ghost[c];
+        }
+        band.triangles.push_back(corners);
+    }
+    return band;
+}
+
+double outlineDistance(const SheetParams& sheet, const Eigen::Vector3d& p) {
+    const Eigen::Vector2d d = p.head<2>() - sheet.center.head<2>();
+    switch (sheet.outline) {
+        case Outline::Disc:
+            return d.norm() - sheet.radius;
+        case Outline::Rectangle: {
+            const Eigen::Vector2d q = d.cwiseAbs() - 0.5 * sheet.size;
+            return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+        }
+        case Outline::Sphere:
+            break;
+    }
+    return -std::numeric_limits<double>::infinity();
+}
+
 namespace {
 
 // The icosahedron's edge is 1.0515 R; each subdivision halves it.

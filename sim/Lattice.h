@@ -22,6 +22,22 @@ struct Lattice {
 /// cells dx^2*sqrt(3)/2. Both are centred on the sheet so the lattice is mirror-symmetric.
 Lattice generateLattice(const SheetParams& sheet);
 
+/// Seed 004's ghost particles for a flat sheet (issue 15): the sheet's lattice continued past
+/// its outline. The ghost sites are the grid points outside the outline that share a triangle
+/// of the continued lattice with a particle; the band's triangles are the continued lattice's
+/// triangles with both a particle and a ghost corner, counter-clockwise from +z, a particle
+/// numbered as generateLattice numbers it and ghost k as particleCount + k. Empty for a sphere,
+/// which has no outline.
+struct GhostBand {
+    std::vector<Eigen::Vector3d> sites;
+    std::vector<std::array<int, 3>> triangles;
+};
+GhostBand ghostBand(const SheetParams& sheet);
+
+/// Signed distance in the rest plane from p to the sheet's outline: negative inside. A sphere
+/// has no outline: -infinity.
+double outlineDistance(const SheetParams& sheet, const Eigen::Vector3d& p);
+
 /// Geodesic sphere: the icosahedron subdivided n times, n the least with edges <= ~dx.
 Lattice generateSphere(const SheetParams& sheet);
 

@@ -47,6 +47,8 @@ Membrane::Membrane(const MembraneParams& given)
     }
     if (params.contact.any()) setUpContact(params);
     if (params.remesh.every > 0) remesher_.emplace(x0_, bonds_, sheet.dx);
+    levelSet_ = ParticleLevelSet(sheet, x0_, lattice_.triangles, bonds_.offsets, bonds_.partners);
+    levelSet_.start(x_, damageState_.bondAlive());
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
     controller_ = TimeStepController(params.time);
     const MaterialParams& m = params.material;
@@ -305,6 +307,8 @@ void Membrane::step() {
                             dt_);  // theta^n -> theta^n+1
         forcesCurrent_ = false;
     }
+    levelSet_.advance(x_, v_, damageState_.bondAlive(), damageState_.brokenBondCount(), dt_,
+                      steps_ + 1);
     time_ += dt_;
     ++steps_;
     if (contact_) contact_->place(time_);
@@ -443,6 +447,13 @@ FrameView Membrane::view(int frame) const {
     v.bondAlive = damageState_.bondAlive();
     v.keptTriangles = damageState_.keptTriangles();
     v.triangleAlive = damageState_.triangleAlive();
+    v.levelSet = levelSet_.phi();
+    v.ghostPositions = levelSet_.ghostPositions();
+    v.ghostRestPositions = levelSet_.ghostRestPositions();
+    v.ghostLevelSet = levelSet_.ghostPhi();
+    v.ghostAnchors = levelSet_.ghostAnchors();
+    v.bandTriangles = levelSet_.bandTriangles();
+    v.bandKept = levelSet_.bandKept();
     if (contact_) {
         v.colliders = contact_->colliders();
         v.colliderPoses = contact_->poses();

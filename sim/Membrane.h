@@ -26,6 +26,7 @@
 #include "sim/Lattice.h"
 #include "sim/Parallel.h"
 #include "sim/Params.h"
+#include "sim/ParticleLevelSet.h"
 #include "sim/Random.h"
 #include "sim/Remesh.h"
 #include "sim/Solver.h"
@@ -206,6 +207,7 @@ private:
     BlowUpGuard guard_;
     std::unique_ptr<Solver> solver_;        ///< the internal forces
     std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
+    ParticleLevelSet levelSet_;             ///< seed 004's, of the outline (issue 15)
     std::optional<Remesher> remesher_;      ///< remesh.every > 0
     double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for

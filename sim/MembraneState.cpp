@@ -24,6 +24,7 @@ void Membrane::visitState(Self& m, Archive& a) {
         throw StateMismatch(hasContact ? "the state has contact, this scene none"
                                        : "this scene has contact, the state none");
     if (m.contact_) Contact::visitState(*m.contact_, a);
+    ParticleLevelSet::visitState(m.levelSet_, a);
 }
 
 std::vector<std::byte> Membrane::saveState() const {

@@ -325,7 +325,9 @@ std::string describeEstimate(const RunEstimate& e) {
 sim::Membrane prepareMembrane(const Scene& scene) {
     sim::Membrane membrane = [&] {
         try {
-            return sim::Membrane(scene.sim);
+            sim::MembraneParams params = scene.sim;
+            params.particleLevelSet = scene.render.surface == render::SurfaceKind::ParticleLevelSet;
+            return sim::Membrane(params);
         } catch (const std::invalid_argument& e) {
             throw SceneError(scene.file.string() + ": error: " + e.what());
         }

@@ -481,7 +481,8 @@ public:
 
     /// The particle level set's outline: each kept band triangle's inside part (Phi <= 0), cut
     /// at Phi = 0 along its particle-ghost edges, in the triangle's own (counter-clockwise)
-    /// order. Slivers (a particle on the outline, Phi = 0) are left out.
+    /// order. A particle on the outline (Phi = 0) is its own crossing, and the slivers that
+    /// leaves are left out.
     void addBand(const sim::FrameView& frame) {
         const int n = static_cast<int>(frame.particleCount());
         std::unordered_map<std::uint64_t, std::uint32_t> crossings;
@@ -490,6 +491,7 @@ public:
             if (const auto found = crossings.find(key); found != crossings.end())
                 return found->second;
             const double phi = frame.levelSet[i];
+            if (!(phi < 0.0)) return static_cast<std::uint32_t>(i);  // the particle is on it
             const double t = phi / (phi - frame.ghostLevelSet[g]);
             const Eigen::Vector3d restPoint = rest(i) + t * (frame.ghostRestPositions[g] - rest(i));
             const std::uint32_t v = add(x(i) + t * (frame.ghostPositions[g] - x(i)),

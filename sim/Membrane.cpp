@@ -47,8 +47,10 @@ Membrane::Membrane(const MembraneParams& given)
     }
     if (params.contact.any()) setUpContact(params);
     if (params.remesh.every > 0) remesher_.emplace(x0_, bonds_, sheet.dx);
-    levelSet_ = ParticleLevelSet(sheet, x0_, lattice_.triangles, bonds_.offsets, bonds_.partners);
-    levelSet_.start(x_, damageState_.bondAlive());
+    if (params.particleLevelSet && sheet.outline != Outline::Sphere) {
+        levelSet_.emplace(makeLevelSet());
+        levelSet_->start(x_, damageState_.bondAlive());
+    }
     dt_ = params.time.dt.value_or(params.time.safety * stableDt_);
     controller_ = TimeStepController(params.time);
     const MaterialParams& m = params.material;
@@ -56,6 +58,11 @@ Membrane::Membrane(const MembraneParams& given)
         criticalStretch_ = std::sqrt(2.0 * std::numbers::pi * *m.fractureEnergy /
                                      (3.0 * m.youngsModulus * horizon_));
     updateDamage();
+}
+
+ParticleLevelSet Membrane::makeLevelSet() const {
+    return ParticleLevelSet(params_.sheet, x0_, lattice_.triangles, bonds_.offsets,
+                            bonds_.partners);
 }
 
 void Membrane::setStableStep(double worstRatio) {
@@ -307,8 +314,9 @@ void Membrane::step() {
                             dt_);  // theta^n -> theta^n+1
         forcesCurrent_ = false;
     }
-    levelSet_.advance(x_, v_, damageState_.bondAlive(), damageState_.brokenBondCount(), dt_,
-                      steps_ + 1);
+    if (levelSet_)
+        levelSet_->advance(x_, v_, damageState_.bondAlive(), damageState_.brokenBondCount(), dt_,
+                           steps_ + 1);
     time_ += dt_;
     ++steps_;
     if (contact_) contact_->place(time_);
@@ -447,13 +455,15 @@ FrameView Membrane::view(int frame) const {
     v.bondAlive = damageState_.bondAlive();
     v.keptTriangles = damageState_.keptTriangles();
     v.triangleAlive = damageState_.triangleAlive();
-    v.levelSet = levelSet_.phi();
-    v.ghostPositions = levelSet_.ghostPositions();
-    v.ghostRestPositions = levelSet_.ghostRestPositions();
-    v.ghostLevelSet = levelSet_.ghostPhi();
-    v.ghostAnchors = levelSet_.ghostAnchors();
-    v.bandTriangles = levelSet_.bandTriangles();
-    v.bandKept = levelSet_.bandKept();
+    if (levelSet_) {
+        v.levelSet = levelSet_->phi();
+        v.ghostPositions = levelSet_->ghostPositions();
+        v.ghostRestPositions = levelSet_->ghostRestPositions();
+        v.ghostLevelSet = levelSet_->ghostPhi();
+        v.ghostAnchors = levelSet_->ghostAnchors();
+        v.bandTriangles = levelSet_->bandTriangles();
+        v.bandKept = levelSet_->bandKept();
+    }
     if (contact_) {
         v.colliders = contact_->colliders();
         v.colliderPoses = contact_->poses();

@@ -175,6 +175,7 @@ private:
     void checkFinite();  ///< the blow-up guard, after every step
     /// Notches: breaks the bonds they cross and has the solver cut the same edges.
     void setUpNotches(const MembraneParams& params);
+    ParticleLevelSet makeLevelSet() const;
     void assignBoundaries();
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
@@ -205,10 +206,10 @@ private:
     double time_ = 0.0;
     long steps_ = 0;
     BlowUpGuard guard_;
-    std::unique_ptr<Solver> solver_;        ///< the internal forces
-    std::unique_ptr<Workspace> workspace_;  ///< the solver's scratch for step()
-    ParticleLevelSet levelSet_;             ///< seed 004's, of the outline (issue 15)
-    std::optional<Remesher> remesher_;      ///< remesh.every > 0
+    std::unique_ptr<Solver> solver_;            ///< the internal forces
+    std::unique_ptr<Workspace> workspace_;      ///< the solver's scratch for step()
+    std::optional<ParticleLevelSet> levelSet_;  ///< params.particleLevelSet, a flat sheet
+    std::optional<Remesher> remesher_;          ///< remesh.every > 0
     double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
     long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
     double lastDrift_ = 0.0;   ///< the last symplectic Euler drift, 0 before the first

@@ -2,6 +2,8 @@
 // constructor derives from the scene (lattice, bonds, masses, the solver's rest quantities,
 // diffusion's sources, the contact's triangles) is rebuilt, not stored.
 
+#include <type_traits>
+
 #include "sim/Membrane.h"
 
 namespace rend::sim {
@@ -24,7 +26,20 @@ void Membrane::visitState(Self& m, Archive& a) {
         throw StateMismatch(hasContact ? "the state has contact, this scene none"
                                        : "this scene has contact, the state none");
     if (m.contact_) Contact::visitState(*m.contact_, a);
-    ParticleLevelSet::visitState(m.levelSet_, a);
+    std::uint8_t hasLevelSet = m.levelSet_.has_value();
+    a(hasLevelSet);
+    if (!hasLevelSet && m.levelSet_)
+        throw StateMismatch(
+            "this run draws surface = \"particle_level_set\", whose particle level set the state "
+            "lacks (its run drew another surface)");
+    if (m.levelSet_) {
+        ParticleLevelSet::visitState(*m.levelSet_, a);
+    } else if constexpr (!std::is_const_v<Self>) {
+        if (hasLevelSet) {  // read past it: it never changed the motion
+            ParticleLevelSet unused = m.makeLevelSet();
+            ParticleLevelSet::visitState(unused, a);
+        }
+    }
 }
 
 std::vector<std::byte> Membrane::saveState() const {

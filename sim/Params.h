@@ -209,6 +209,9 @@ struct MembraneParams {
     std::vector<MaterialMap> materialMaps;  ///< E, G_f and density over the sheet
     MpmParams mpm;
     RemeshParams remesh;
+    /// Carry seed 004's particle level set of the outline (sim/ParticleLevelSet.h): set where the
+    /// surface draws it (render.surface = "particle_level_set"); it never changes the motion.
+    bool particleLevelSet = false;
 };
 
 }  // namespace rend::sim

@@ -15,17 +15,6 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-/// A piece of the zero level set: the segment from a to b (a point where they are equal).
-struct Segment {
-    Eigen::Vector3d a, b;
-    double distance(const Eigen::Vector3d& p) const {
-        const Eigen::Vector3d ab = b - a;
-        const double length2 = ab.squaredNorm();
-        const double s = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-        return (p - (a + s * ab)).norm();
-    }
-};
-
 int bondBetween(std::span<const int> offsets, std::span<const int> partners, int i, int j) {
     for (int b = offsets[i]; b < offsets[i + 1]; ++b)
         if (partners[b] == j) return b;
@@ -79,12 +68,37 @@ ParticleLevelSet::ParticleLevelSet(const SheetParams& sheet, std::span<const Eig
         }
     ghost_ = restGhost_;
     bandKept_.assign(band_.size(), 1);
+    findSupports();
+}
+
+// Each ghost's support, fixed at rest: its anchor and the anchor's lattice neighbours, weighted
+// by 1 - r / 2dx in rest distance from the ghost's site (those at 2 dx or more left out).
+void ParticleLevelSet::findSupports() {
+    const double reach = 2.0 * dx_;
+    supportOffsets_.assign(1, 0);
+    for (std::size_t g = 0; g < restGhost_.size(); ++g) {
+        const int a = anchor_[g];
+        auto add = [&](int p, int bond) {
+            const double w = 1.0 - (rest_[p] - restGhost_[g]).norm() / reach;
+            if (w > 0.0) support_.push_back({p, bond, w});
+        };
+        add(a, -1);
+        for (const Neighbour& k : neighbours(a)) add(k.particle, k.bond);
+        supportOffsets_.push_back(int(support_.size()));
+    }
 }
 
 bool ParticleLevelSet::joined(int i, int j, std::span<const std::uint8_t> alive) const {
     if (i == j) return true;
     for (const Neighbour& k : neighbours(i))
         if (k.particle == j) return k.bond < 0 || alive[k.bond];
+    return false;
+}
+
+bool ParticleLevelSet::nearlyJoined(int i, int j, std::span<const std::uint8_t> alive) const {
+    if (joined(i, j, alive)) return true;
+    for (const Neighbour& k : neighbours(i))
+        if ((k.bond < 0 || alive[k.bond]) && joined(k.particle, j, alive)) return true;
     return false;
 }
 
@@ -97,7 +111,7 @@ void ParticleLevelSet::keepBand(std::span<const std::uint8_t> alive) {
             if (c[a] >= n) {  // its anchor is a corner or joined to one
                 const int anchor = anchor_[c[a] - n];
                 bool near = false;
-                for (int p : c) near = near || (p < n && joined(anchor, p, alive));
+                for (int p : c) near = near || (p < n && nearlyJoined(anchor, p, alive));
                 kept = near;
                 continue;
             }
@@ -146,19 +160,14 @@ void ParticleLevelSet::advance(std::span<const Eigen::Vector3d> x,
                                std::span<const Eigen::Vector3d> v,
                                std::span<const std::uint8_t> alive, std::size_t broken, double dt,
                                long step) {
-    const double reach = 2.0 * dx_;
     for (std::size_t g = 0; g < ghost_.size(); ++g) {
-        const int a = anchor_[g];
-        auto weight = [&](int p) {
-            return std::max(0.0, 1.0 - (rest_[p] - restGhost_[g]).norm() / reach);
-        };
-        double total = weight(a);
-        Eigen::Vector3d sum = total * v[a];
-        for (const Neighbour& k : neighbours(a)) {
+        double total = 0.0;
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int s = supportOffsets_[g]; s < supportOffsets_[g + 1]; ++s) {
+            const Support& k = support_[s];
             if (k.bond >= 0 && !alive[k.bond]) continue;
-            const double w = weight(k.particle);
-            sum += w * v[k.particle];
-            total += w;
+            sum += k.weight * v[k.particle];
+            total += k.weight;
         }
         if (total > 0.0) ghost_[g] += dt * sum / total;
     }
@@ -166,20 +175,17 @@ void ParticleLevelSet::advance(std::span<const Eigen::Vector3d> x,
     if (step % kReinitialiseEvery == 0) reinitialise(x, alive);
 }
 
-void ParticleLevelSet::reinitialise(std::span<const Eigen::Vector3d> x,
-                                    std::span<const std::uint8_t> alive) {
-    placeGhosts(x, alive);
+void ParticleLevelSet::offer(int i, const Segment& zero, std::span<const Eigen::Vector3d> x) {
+    const double d = zero.distance(x[i]);
+    if (distance_[i] == kInfinity) touched_.push_back(i);
+    if (d < distance_[i]) distance_[i] = d, closest_[i] = zero;
+}
+
+void ParticleLevelSet::findZeroSet(std::span<const Eigen::Vector3d> x,
+                                   std::span<const std::uint8_t> alive) {
     const int n = int(phi_.size());
-    std::vector<double> distance(n, kInfinity);
-    std::vector<Segment> closest(n);
-    auto offer = [&](int i, const Segment& z) {
-        const double d = z.distance(x[i]);
-        if (d < distance[i]) distance[i] = d, closest[i] = z;
-    };
-    // The zero set: the outline's, the segment through each kept band triangle between the
-    // crossings on its particle-ghost edges, which its particles measure their distance to and
-    // hold (their values are left as they are below)...
-    std::vector<std::uint8_t> holds(n, 0);
+    // The outline's: the segment through each kept band triangle between the crossings on its
+    // particle-ghost edges, which its particles measure their distance to and hold.
     for (std::size_t t = 0; t < band_.size(); ++t) {
         if (!bandKept_[t]) continue;
         std::array<Eigen::Vector3d, 2> crossing;
@@ -195,9 +201,10 @@ void ParticleLevelSet::reinitialise(std::span<const Eigen::Vector3d> x,
         }
         if (count < 2) continue;
         for (int i : band_[t])
-            if (i < n) offer(i, {crossing[0], crossing[1]}), holds[i] = 1;
+            if (i < n) offer(i, {crossing[0], crossing[1]}, x), holds_[i] = 1;
     }
-    // ...and each crack's, a point on both sides of every broken lattice edge.
+    // Each crack's: a point on both sides of every broken lattice edge.
+    if (brokenSeen_ == 0) return;
     for (int i = 0; i < n; ++i)
         for (const Neighbour& k : neighbours(i)) {
             if (k.bond < 0 || alive[k.bond]) continue;
@@ -208,30 +215,45 @@ void ParticleLevelSet::reinitialise(std::span<const Eigen::Vector3d> x,
                              : Eigen::Vector3d((rest_[k.particle] - rest_[i]).normalized());
             const Eigen::Vector3d lip =
                 x[i] + 0.5 * (rest_[k.particle] - rest_[i]).norm() * direction;
-            offer(i, {lip, lip});
+            offer(i, {lip, lip}, x);
         }
+}
+
+void ParticleLevelSet::reinitialise(std::span<const Eigen::Vector3d> x,
+                                    std::span<const std::uint8_t> alive) {
+    placeGhosts(x, alive);
+    const int n = int(phi_.size());
+    if (distance_.size() != std::size_t(n)) {
+        distance_.assign(n, kInfinity);
+        closest_.resize(n);
+        holds_.assign(n, 0);
+    }
+    findZeroSet(x, alive);
     // Closest points handed on through intact lattice edges, nearest first (serial: the same
     // bits whatever the thread count).
     const double band = kBand * dx_;
     using Entry = std::pair<double, int>;
     std::priority_queue<Entry, std::vector<Entry>, std::greater<>> front;
-    for (int i = 0; i < n; ++i)
-        if (distance[i] < band) front.emplace(distance[i], i);
+    for (int i : touched_)
+        if (distance_[i] < band) front.emplace(distance_[i], i);
     while (!front.empty()) {
         const auto [d, i] = front.top();
         front.pop();
-        if (d > distance[i]) continue;
+        if (d > distance_[i]) continue;
         for (const Neighbour& k : neighbours(i)) {
             if (k.bond >= 0 && !alive[k.bond]) continue;
-            const double e = closest[i].distance(x[k.particle]);
-            if (e < distance[k.particle] && e < band) {
-                distance[k.particle] = e, closest[k.particle] = closest[i];
+            const double e = closest_[i].distance(x[k.particle]);
+            if (e < distance_[k.particle] && e < band) {
+                if (distance_[k.particle] == kInfinity) touched_.push_back(k.particle);
+                distance_[k.particle] = e, closest_[k.particle] = closest_[i];
                 front.emplace(e, k.particle);
             }
         }
     }
     for (int i = 0; i < n; ++i)
-        if (!holds[i]) phi_[i] = -std::min(distance[i], band);
+        if (!holds_[i]) phi_[i] = -std::min(distance_[i], band);
+    for (int i : touched_) distance_[i] = kInfinity, holds_[i] = 0;
+    touched_.clear();
 }
 
 }  // namespace rend::sim

@@ -29,6 +29,7 @@
 // no outline: no ghosts, and Phi only measures the distance to cracks.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -80,6 +81,27 @@ public:
     }
 
 private:
+    /// A piece of the zero level set: the segment from a to b (a point where they are equal).
+    struct Segment {
+        Eigen::Vector3d a, b;
+        double distance(const Eigen::Vector3d& p) const {
+            const Eigen::Vector3d ab = b - a;
+            const double length2 = ab.squaredNorm();
+            const double s = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+            return (p - (a + s * ab)).norm();
+        }
+    };
+    /// A particle of a ghost's support: its bond from the anchor (-1: the anchor) and weight.
+    struct Support {
+        int particle, bond;
+        double weight;
+    };
+    void findSupports();
+    /// Offers particle i a zero-set segment (reinitialise's scratch: distance_, closest_).
+    void offer(int i, const Segment& zero, std::span<const Eigen::Vector3d> x);
+    /// The outline's and the cracks' zero set, offered to the particles beside it.
+    void findZeroSet(std::span<const Eigen::Vector3d> x, std::span<const std::uint8_t> alive);
+
     /// A lattice edge from a particle: the other end and the bond to it (-1: none).
     struct Neighbour {
         int particle, bond;
@@ -89,9 +111,11 @@ private:
                 std::size_t(neighbourOffsets_[i + 1] - neighbourOffsets_[i])};
     }
     bool joined(int i, int j, std::span<const std::uint8_t> alive) const;
+    /// Joined, or both joined to a common lattice neighbour.
+    bool nearlyJoined(int i, int j, std::span<const std::uint8_t> alive) const;
     /// A band triangle is kept while its particles are pairwise joined by intact lattice edges
-    /// and each ghost's anchor is one of them or joined to one: so no band triangle spans a
-    /// crack that reaches the outline.
+    /// and each ghost's anchor is one of them or nearly joined to one: so no band triangle spans
+    /// a crack that reaches the outline.
     void keepBand(std::span<const std::uint8_t> alive);
     void placeGhosts(std::span<const Eigen::Vector3d> x, std::span<const std::uint8_t> alive);
     /// The least-squares deformation of particle a's intact lattice neighbourhood; false where
@@ -109,6 +133,13 @@ private:
     std::vector<std::array<int, 3>> band_;
     std::vector<std::uint8_t> bandKept_;
     std::size_t brokenSeen_ = std::size_t(-1);  ///< the broken-bond count keepBand last saw
+    std::vector<int> supportOffsets_;
+    std::vector<Support> support_;
+    // reinitialise()'s scratch, kept between calls: only the narrow band's entries are touched.
+    std::vector<double> distance_;
+    std::vector<Segment> closest_;
+    std::vector<std::uint8_t> holds_;
+    std::vector<int> touched_;
 };
 
 }  // namespace rend::sim

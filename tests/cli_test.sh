@@ -354,6 +354,20 @@ check "skip-existing redraws what is missing" run 0 render "$tmp/farm" --frames 
 check "the redrawn frame is the run's" cmp -s "$tmp/farm/frames/frame_0020.png" "$tmp/straight/frames/frame_0020.png"
 check "render exports from the cache" run 0 render "$tmp/farm" --frames 48 --export ply --renderer none
 check "export written" test -s "$tmp/farm/meshes/frame_0048.ply"
+# The particle level set is state, carried only by a run that draws it: its cache redraws a
+# frame with surface = "particle_level_set" as the run drew it, and a cache without it is
+# refused with the reason.
+check "level-set run" run 0 run "${cached[@]}" --frames 24 --surface particle_level_set --out "$tmp/pls"
+check "level-set cache of another surface refused" run 2 render "$tmp/farm" --frames 24 --surface particle_level_set
+check "level-set refusal names the reason" grep -q "whose particle level set the state lacks" "$tmp/stderr"
+mkdir -p "$tmp/farm_pls"
+cp -r "$tmp/pls/cache" "$tmp/farm_pls/"
+check "render a cached frame with the level-set surface" run 0 render "$tmp/farm_pls" --frames 24 --surface particle_level_set --threads 1
+check "the level-set frame from the cache is the run's" cmp -s "$tmp/farm_pls/frames/frame_0024.png" "$tmp/pls/frames/frame_0024.png"
+check "a level-set cache redraws the lattice surface too" run 0 render "$tmp/farm_pls" --frames 12 --threads 1
+check "its lattice frame is the lattice run's" cmp -s "$tmp/farm_pls/frames/frame_0012.png" "$tmp/straight/frames/frame_0012.png"
+differ() { ! cmp -s "$1" "$2"; }
+check "the level-set frame differs from the lattice one" differ "$tmp/pls/frames/frame_0024.png" "$tmp/straight/frames/frame_0024.png"
 rm "$tmp/farm/frames/frame_0030.png"
 printf 'x' | dd of="$tmp/farm/cache/frame_0030.rcache" bs=1 seek=300 conv=notrunc 2>/dev/null
 check "damaged cache file refused" run 2 render "$tmp/farm" --frames 30

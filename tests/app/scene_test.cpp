@@ -308,11 +308,11 @@ INSTANTIATE_TEST_SUITE_P(
                  {"output.export: expected an array of format names, one of \"ply\", \"obj\", "
                   "\"glb\", \"vdb\"",
                   "found a string \"stl\""}},
-        BadScene{
-            "bad_surface.toml",
-            "11:11",
-            {"render.surface: expected one of \"lattice\", \"splat\", \"vdb\", found \"splats\"",
-             "Did you mean \"splat\"?"}},
+        BadScene{"bad_surface.toml",
+                 "11:11",
+                 {"render.surface: expected one of \"lattice\", \"splat\", \"vdb\", "
+                  "\"particle_level_set\", found \"splats\"",
+                  "Did you mean \"splat\"?"}},
         BadScene{"bad_law.toml",
                  "9:7",
                  {"material.law: expected one of \"linear\", \"power_law\", \"elastoplastic\", "

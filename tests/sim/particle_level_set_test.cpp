@@ -36,6 +36,7 @@ SheetParams rectangle(LatticeKind kind) {
 MembraneParams freeSheet(const SheetParams& sheet) {
     MembraneParams p;
     p.sheet = sheet;
+    p.particleLevelSet = true;
     return p;
 }
 
@@ -206,4 +207,32 @@ TEST(ParticleLevelSet, ACrackIsABoundaryOfTheLevelSet) {
     }
     EXPECT_GT(beside, 4);
     EXPECT_GT(far, 4);
+}
+
+// The level set is state: a checkpoint resumes it bit for bit. A run that does not draw it
+// reads past it, and a run that draws it refuses a state without it.
+TEST(ParticleLevelSet, ACheckpointCarriesItAndARunWithoutItReadsPast) {
+    const MembraneParams p = freeSheet(disc());
+    Membrane a(p);
+    for (int i = 0; i < a.particleCount(); ++i) a.velocities()[i] = {0.0, 0.0, 0.01 * i};
+    for (int s = 0; s < 30; ++s) a.step();
+    const std::vector<std::byte> state = a.saveState();
+    const std::vector<Eigen::Vector3d> saved = a.positions();
+    Membrane b(p);
+    b.loadState(state);
+    for (int s = 0; s < 30; ++s) a.step(), b.step();
+    const FrameView va = a.view(1), vb = b.view(1);
+    ASSERT_EQ(va.ghostPositions.size(), vb.ghostPositions.size());
+    for (std::size_t g = 0; g < va.ghostPositions.size(); ++g) {
+        ASSERT_EQ(va.ghostPositions[g], vb.ghostPositions[g]);
+        ASSERT_EQ(va.ghostLevelSet[g], vb.ghostLevelSet[g]);
+    }
+    for (int i = 0; i < a.particleCount(); ++i) ASSERT_EQ(va.levelSet[i], vb.levelSet[i]);
+    MembraneParams plain = p;
+    plain.particleLevelSet = false;
+    Membrane c(plain);
+    c.loadState(state);
+    EXPECT_EQ(c.positions(), saved);
+    EXPECT_TRUE(c.view(1).ghostPositions.empty());
+    EXPECT_THROW(Membrane(p).loadState(c.saveState()), StateMismatch);
 }

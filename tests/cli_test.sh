@@ -364,6 +364,9 @@ mkdir -p "$tmp/farm_pls"
 cp -r "$tmp/pls/cache" "$tmp/farm_pls/"
 check "render a cached frame with the level-set surface" run 0 render "$tmp/farm_pls" --frames 24 --surface particle_level_set --threads 1
 check "the level-set frame from the cache is the run's" cmp -s "$tmp/farm_pls/frames/frame_0024.png" "$tmp/pls/frames/frame_0024.png"
+check "level-set stretch run" run 0 run scenes/stretch.toml --set time.duration=0.25 --renderer none --surface particle_level_set --cache-every 0 --out "$tmp/pls_hash"
+check "lattice stretch run" run 0 run scenes/stretch.toml --set time.duration=0.25 --renderer none --cache-every 0 --out "$tmp/lat_hash"
+check "the level set never changes the motion" test "$(state_hash "$tmp/pls_hash")" = "$(state_hash "$tmp/lat_hash")"
 check "a level-set cache redraws the lattice surface too" run 0 render "$tmp/farm_pls" --frames 12 --threads 1
 check "its lattice frame is the lattice run's" cmp -s "$tmp/farm_pls/frames/frame_0012.png" "$tmp/straight/frames/frame_0012.png"
 differ() { ! cmp -s "$1" "$2"; }

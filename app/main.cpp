@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -19,6 +20,7 @@
 #include "app/Scene.h"
 #include "app/SceneError.h"
 #include "app/SceneNames.h"
+#include "app/Threads.h"
 #include "render/SheetVolume.h"
 #include "render/SplatSurface.h"
 #include "render/Versions.h"
@@ -30,7 +32,8 @@ void printVersions() {
     std::printf("rend %s\n", REND_VERSION);
     std::printf("  %-10s %d.%d.%d\n", "Eigen", EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION,
                 EIGEN_MINOR_VERSION);
-    std::printf("  %-10s spec %d, %d threads\n", "OpenMP", _OPENMP, omp_get_max_threads());
+    std::printf("  %-10s spec %d, %d threads, %d cores usable\n", "OpenMP", _OPENMP,
+                omp_get_max_threads(), rend::usableCores());
     std::printf("  %-10s %d.%d.%d\n", "toml++", TOML_LIB_MAJOR, TOML_LIB_MINOR, TOML_LIB_PATCH);
     std::printf("  %-10s %s\n", "CLI11", CLI11_VERSION);
     for (const auto& [name, version] : rend::render::renderLibraryVersions())
@@ -143,8 +146,17 @@ void applyOverrides(const RunArgs& a, rend::Scene& scene) {
     if (a.spp > 0) scene.render.pathTracing.samplesPerPixel = a.spp;
 }
 
+/// --threads, else OMP_NUM_THREADS, else the cores this process may use (affinity and cgroup
+/// quota), which OpenMP's own default does not look at.
+void setThreads(int threads) {
+    if (threads > 0)
+        omp_set_num_threads(threads);
+    else if (std::getenv("OMP_NUM_THREADS") == nullptr)
+        omp_set_num_threads(rend::usableCores());
+}
+
 int runCommand(const RunArgs& a) {
-    if (a.threads > 0) omp_set_num_threads(a.threads);
+    setThreads(a.threads);
     rend::Scene scene = rend::loadScene(a.scene, withQuality(a.sets, a.quality));
     applyOverrides(a, scene);
     rend::RunOptions options;
@@ -167,7 +179,7 @@ int runCommand(const RunArgs& a) {
 }
 
 int renderCommand(const RunArgs& a) {
-    if (a.threads > 0) omp_set_num_threads(a.threads);
+    setThreads(a.threads);
     auto [file, sets] = rend::cacheSource(a.out);
     sets.insert(sets.end(), a.sets.begin(), a.sets.end());  // the look may change; not the sim
     rend::Scene scene = rend::loadScene(file, sets);
@@ -227,7 +239,10 @@ void addOutputOptions(CLI::App* command, RunArgs& a) {
         ->check(nonEmpty("a list of ply, obj, glb, vdb", "--export ply,vdb"));
     command->add_option("--spp", a.spp, "Path-traced samples per pixel (embree)")
         ->check(CLI::Range(1, 4096));
-    command->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")
+    command
+        ->add_option("--threads", a.threads,
+                     "OpenMP threads (default: OMP_NUM_THREADS, else the cores this process "
+                     "may use)")
         ->check(CLI::Range(1, 1024));
 }
 

@@ -33,6 +33,11 @@ no_partial_files() { ! find "$1" -name '*.tmp' -o -name '*.partial' | grep -q .;
 
 # --version names every library actually in use.
 check "version" run 0 --version
+# The default thread count is the cores this process may use (app/Threads.h): one CPU of
+# affinity, one thread; OMP_NUM_THREADS still wins.
+if command -v taskset >/dev/null; then
+    check "one CPU of affinity, one thread" bash -c "taskset -c 0 '$rend' --version | grep -q 'spec [0-9]*, 1 threads, 1 cores usable'"
+fi
 for lib in Eigen OpenMP Embree OpenVDB assimp OSMesa; do
     check "version names $lib" grep -q "$lib" "$tmp/stdout"
 done

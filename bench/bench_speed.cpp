@@ -1,0 +1,159 @@
+// Issue 16's speed figures in one run: the membrane step of scenes/stretch.toml on a square
+// lattice at dt = 1e-4 (the sheet LAMMPS's peri/pmb is compared on), grown from 10^4 to 10^7
+// particles at the same spacing. Per size: the bonds per particle, the bytes per particle (the
+// resident memory the membrane and its first steps took), and ns per particle-step on 1 thread
+// and on every usable core, with the speed-up. When `lmp` is on the PATH, LAMMPS runs the
+// 10,201-particle sheet with peri/pmb in the same run, and its ratio to rend is printed.
+//
+//   build/bench_speed [--largest N]   (default 10000000; sizes 1e4, 1e5, 1e6, 1e7 up to it)
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/Scene.h"
+#include "app/Threads.h"
+#include "sim/Membrane.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Resident memory of this process, in bytes (/proc/self/statm's second field, in pages).
+double residentBytes() {
+    std::ifstream in("/proc/self/statm");
+    double pages = 0.0, resident = 0.0;
+    in >> pages >> resident;
+    return resident * double(sysconf(_SC_PAGESIZE));
+}
+
+/// ns per particle-step over enough steps to take about `seconds` (at least 3).
+double nsPerParticleStep(rend::sim::Membrane& membrane, int threads, double seconds) {
+    omp_set_num_threads(threads);
+    membrane.step();  // the first step at this count pays for the thread pool
+    auto start = Clock::now();
+    membrane.step();
+    const double one = std::max(secondsSince(start), 1e-6);
+    const int steps = std::max(3, int(seconds / one));
+    start = Clock::now();
+    for (int s = 0; s < steps; ++s) membrane.step();
+    return secondsSince(start) / steps / membrane.particleCount() * 1e9;
+}
+
+struct Row {
+    long particles = 0;
+    double bondsPerParticle = 0.0, bytesPerParticle = 0.0, setupSeconds = 0.0;
+    double ns1 = 0.0, nsAll = 0.0;
+};
+
+Row measure(rend::sim::MembraneParams params, int side, int cores) {
+    params.sheet.size = Eigen::Vector2d::Constant((side - 1) * params.sheet.dx);
+    Row row;
+    const double before = residentBytes();
+    const auto start = Clock::now();
+    rend::sim::Membrane membrane(params);
+    row.setupSeconds = secondsSince(start);
+    row.particles = membrane.particleCount();
+    row.bondsPerParticle = double(membrane.bonds().directedCount()) / row.particles;
+    omp_set_num_threads(cores);
+    membrane.step();  // the solvers' workspaces are allocated at the first step
+    row.bytesPerParticle = (residentBytes() - before) / row.particles;
+    row.ns1 = nsPerParticleStep(membrane, 1, 2.0);
+    row.nsAll = cores > 1 ? nsPerParticleStep(membrane, cores, 2.0) : row.ns1;
+    return row;
+}
+
+/// peri/pmb on rend's 10,201-particle square sheet (101 x 101, 0.02 m, horizon 1.5 dx: 7.9
+/// bonds each, as rend's), 500 steps of 1e-4 s on one thread. Returns ns per particle-step, or
+/// a negative number when `lmp` is missing or its output does not parse.
+double lammpsNsPerParticleStep() {
+    if (std::system("command -v lmp > /dev/null 2>&1") != 0) return -1.0;
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("rend_bench_speed_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "in.peri") << R"(units si
+dimension 3
+boundary f f f
+atom_style peri
+atom_modify map array
+lattice sc 0.02
+region box block -3 103 -3 103 -3 3
+region sheet block -0.5 100.5 -0.5 100.5 -0.5 0.5
+create_box 1 box
+create_atoms 1 region sheet
+pair_style peri/pmb
+pair_coeff * * 1.0e12 0.0301 0.005 0.25
+set group all density 2000.0
+set group all volume 8.0e-6
+velocity all create 1.0e-6 87287 loop geom
+fix 1 all nve
+neighbor 0.005 bin
+neigh_modify every 1000 delay 0 check yes
+timestep 1.0e-4
+thermo 1000
+run 500
+)";
+    const std::string command =
+        "cd '" + dir.string() + "' && OMP_NUM_THREADS=1 lmp -in in.peri -log none > out.txt 2>&1";
+    const int status = std::system(command.c_str());
+    std::ifstream in(dir / "out.txt");
+    std::stringstream text;
+    text << in.rdbuf();
+    std::filesystem::remove_all(dir);
+    if (status != 0) return -1.0;
+    std::smatch m;
+    const std::string out = text.str();
+    const std::regex loop(
+        R"(Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps with (\d+) atoms)");
+    if (!std::regex_search(out, m, loop)) return -1.0;
+    return std::stod(m[1]) / std::stod(m[2]) / std::stod(m[3]) * 1e9;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    long largest = 10000000;
+    for (int k = 1; k + 1 < argc; ++k)
+        if (std::string(argv[k]) == "--largest") largest = std::atol(argv[k + 1]);
+    const rend::Scene scene = rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/stretch.toml",
+                                              {"sheet.lattice=\"square\"", "time.dt=1e-4"});
+    const int cores = rend::usableCores();
+    std::printf(
+        "scenes/stretch.toml, square lattice, dt 1e-4, peridynamic bonds; %d usable cores\n",
+        cores);
+    std::printf("%12s %10s %12s %10s %14s %14s %8s\n", "particles", "bonds/p", "bytes/p", "setup s",
+                "ns/p-step 1t", "ns/p-step all", "speedup");
+    double rendAt1e4 = 0.0;
+    for (const int side : {101, 317, 1001, 3163}) {
+        if (long(side) * side > largest * 1.01) break;
+        const Row r = measure(scene.sim, side, cores);
+        if (side == 101) rendAt1e4 = r.ns1;
+        std::printf("%12ld %10.2f %12.0f %10.2f %14.1f %14.1f %8.2f\n", r.particles,
+                    r.bondsPerParticle, r.bytesPerParticle, r.setupSeconds, r.ns1, r.nsAll,
+                    r.ns1 / r.nsAll);
+        std::fflush(stdout);
+    }
+    const double lammps = lammpsNsPerParticleStep();
+    if (lammps < 0.0) {
+        std::printf("LAMMPS: lmp not found or its run failed: no ratio (apt-get install lammps)\n");
+    } else {
+        std::printf(
+            "LAMMPS peri/pmb, 10,201 particles, 1 thread: %.1f ns per particle-step; "
+            "rend %.1f: rend is %.2fx faster\n",
+            lammps, rendAt1e4, lammps / rendAt1e4);
+    }
+}

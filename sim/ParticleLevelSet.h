@@ -17,16 +17,18 @@
 // - Every 20th step (seed 004) the level set is reinitialised to a signed distance in the
 //   current sheet. The ghosts are first put back on the linear extrapolation of their anchor's
 //   neighbourhood (seed 004's other way of assigning them, which the mean velocity drifts from
-//   in a spin). The zero points are then where Phi changes sign along the band's particle-ghost
-//   edges, and, along every broken lattice edge, the crack's crossing on each side (half the
+//   in a spin). The zero set is then the segment where Phi changes sign in each kept band
+//   triangle, and, along every broken lattice edge, the crack's crossing on each side (half the
 //   rest length from the particle towards the other end). Phi of a particle becomes minus its
-//   distance to the nearest zero point, propagated from particle to particle through intact
-//   lattice edges only (closest points handed on, as a vector distance transform), so a crack
-//   is a boundary and distance never leaks across it; a ghost's becomes plus its distance to its
-//   anchor's nearest zero point. Beyond three spacings Phi is held at -3 dx (seed 004's narrow
-//   band).
-// The ghosts' positions and Phi are state (checkpoints and the cache carry them). A sphere has
-// no outline: no ghosts, and Phi only measures the distance to cracks.
+//   distance to the zero set, propagated from particle to particle through intact lattice edges
+//   only (closest segments handed on, as a vector distance transform), so a crack is a boundary
+//   and distance never leaks across it. Beyond three spacings Phi is held at -3 dx (seed 004's
+//   narrow band). The band triangles' particles and the ghosts keep their values: they hold the
+//   interface, which measuring them again from the piecewise-linear zero set moved inward on a
+//   disc (0.27 dx in 50 reinitialisations), the shift seed 004 reports of its own.
+// The ghosts' positions and Phi are state (checkpoints and the cache carry them). Membrane
+// carries a level set only for a flat sheet whose surface draws it (MembraneParams::
+// particleLevelSet); it never changes the motion.
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -14,6 +14,7 @@
 
 #include "app/Cache.h"
 #include "app/FrameWriter.h"
+#include "app/MpiDomain.h"
 #include "app/Outputs.h"
 #include "app/SceneError.h"
 #include "render/AtomicFile.h"
@@ -404,6 +405,37 @@ std::vector<std::string> filesUpTo(const std::filesystem::path& outDir,
     return done;
 }
 
+/// This process's slab when mpirun started several (app/MpiDomain.h), else null.
+std::unique_ptr<sim::Domain> decompose(const Scene& scene, sim::Membrane& membrane) {
+    if (processCount() <= 1) return nullptr;
+    try {
+        std::unique_ptr<sim::Domain> domain = makeMpiDomain(membrane.bonds());
+        membrane.decompose(*domain);
+        return domain;
+    } catch (const std::invalid_argument& e) {
+        throw SceneError(scene.file.string() + ": error: " + e.what());
+    }
+}
+
+/// The steps of a process other than the first: its slab's, with the first's gathers, and
+/// nothing written.
+RunSummary runSlab(const Scene& scene, const RunOptions& options, sim::Membrane& membrane, int last,
+                   int substeps) {
+    RunSummary s;
+    int frame = options.resume ? resumeFromCache(scene, options.outDir, last, membrane) : 0;
+    while (++frame <= last) {
+        membrane.startFrame();
+        if (scene.sim.time.adaptive())
+            membrane.advanceTo(frame / scene.sim.time.fps);
+        else
+            for (int k = 0; k < substeps; ++k) membrane.step();
+        membrane.gatherToFirst();
+    }
+    s.particles = membrane.particleCount();
+    s.steps = membrane.stepCount();
+    return s;
+}
+
 }  // namespace
 
 RunSummary runScene(const Scene& scene, const RunOptions& options) {
@@ -421,7 +453,9 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     s.dt = s.dtMin = s.dtMax = adaptive ? 0.0 : dt;
     s.stableDt = membrane.stableTimeStep();
     s.substeps = adaptive ? 0 : substeps;
-    std::fprintf(stderr, "estimate: %s\n", describeEstimate(estimateRun(scene, membrane)).c_str());
+    if (processRank() == 0)
+        std::fprintf(stderr, "estimate: %s\n",
+                     describeEstimate(estimateRun(scene, membrane)).c_str());
     std::vector<int> selected = options.frames;
     if (selected.empty())
         for (int frame = 1; frame <= scene.frameCount(); ++frame) selected.push_back(frame);
@@ -429,6 +463,8 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
     const auto isSelected = [&](int frame) {
         return std::binary_search(selected.begin(), selected.end(), frame);
     };
+    const std::unique_ptr<sim::Domain> domain = decompose(scene, membrane);
+    if (domain && domain->rank() != 0) return runSlab(scene, options, membrane, last, substeps);
 
     std::filesystem::create_directories(options.outDir);
     int resumedAfter = 0;
@@ -518,6 +554,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
                 membrane.advanceTo(frame / time.fps);
             else
                 for (int k = 0; k < substeps; ++k) membrane.step();
+            membrane.gatherToFirst();  // the whole sheet, from every process's slab
             s.seconds.simulate += secondsSince(t0);
             s.framesSimulated = frame;
             const StatsWriter::Row row = frameStats(frame, membrane);  // checks it is finite

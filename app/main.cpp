@@ -9,13 +9,16 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <thread>
 
 #include "app/FrameSelection.h"
+#include "app/MpiDomain.h"
 #include "app/Pipeline.h"
 #include "app/Scene.h"
 #include "app/SceneError.h"
@@ -36,6 +39,7 @@ void printVersions() {
                 omp_get_max_threads(), rend::usableCores());
     std::printf("  %-10s %d.%d.%d\n", "toml++", TOML_LIB_MAJOR, TOML_LIB_MINOR, TOML_LIB_PATCH);
     std::printf("  %-10s %s\n", "CLI11", CLI11_VERSION);
+    std::printf("  %-10s %s\n", "MPI", rend::mpiVersion().c_str());
     for (const auto& [name, version] : rend::render::renderLibraryVersions())
         std::printf("  %-10s %s\n", name.c_str(), version.c_str());
 }
@@ -170,6 +174,7 @@ int runCommand(const RunArgs& a) {
     options.cacheEvery = a.cacheEvery;
     options.resume = a.resume;
     const rend::RunSummary s = rend::runScene(scene, options);
+    if (rend::processRank() != 0) return 0;  // the first process reports
     std::printf(
         "wrote %s: %d frames (%d images), %d particles, %zu bonds, %ld steps of %.4g s, "
         "%.1f ns per particle-step\n",
@@ -257,7 +262,30 @@ std::string solverHelp() {
 
 }  // namespace
 
+int runMain(int argc, char** argv);
+
+// Several processes under mpirun (app/MpiDomain.h): only the first reports an error, and one
+// that fails ends them all.
 int main(int argc, char** argv) {
+    int code = 0;
+    try {
+        const int processes = rend::startProcesses(argc, argv);
+        if (processes > 1 && rend::processRank() != 0) std::freopen("/dev/null", "w", stderr);
+        code = runMain(argc, argv);
+        // Errors in the scene reach every process at once: the first reports it before the
+        // others end the run, or they would kill it mid-message.
+        if (code != 0 && processes > 1 && rend::processRank() != 0)
+            std::this_thread::sleep_for(std::chrono::seconds(2));
+        if (code != 0 && processes > 1) rend::abortProcesses(code);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        return 1;
+    }
+    rend::endProcesses();
+    return code;
+}
+
+int runMain(int argc, char** argv) {
     CLI::App app{"rend: thin membranes that stretch, wrinkle and tear, rendered to PNG"};
     app.require_subcommand(0, 1);
     bool version = false;

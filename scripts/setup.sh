@@ -9,6 +9,7 @@ packages=(
     zlib1g-dev libopenexr-dev  # OpenEXR 3.1: frames for compositing (render/ExrWriter)
     libosmesa6-dev libstb-dev libassimp-dev libtomlplusplus-dev libcli11-dev
     libzstd-dev  # the simulation cache (app/Cache): compressed, checksummed frames
+    libopenmpi-dev openmpi-bin  # mpirun -np N rend run (app/MpiDomain), tests/mpi_test.sh
     python3-matplotlib  # scripts/plot_run.py and plot_bench.py (tested in tests/cli_test.sh)
     libgtest-dev libbenchmark-dev
     clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer with ASan and UBSan over the loader

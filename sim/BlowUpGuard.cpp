@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -117,12 +118,13 @@ void BlowUpGuard::sampleBlock(const State& s, int begin, int end, Sample& out) c
 }
 
 BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
-    const int n = int(s.v.size());
-    const int blocks = (n + kBlock - 1) / kBlock;
+    const int first = s.domain ? s.domain->slab().begin : 0;
+    const int n = s.domain ? s.domain->slab().end : int(s.v.size());
+    const int blocks = (n - first + kBlock - 1) / kBlock;
     blocks_.assign(blocks, Sample{});
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
+#pragma omp parallel for schedule(static) if (n - first >= kParallelThreshold)
     for (int b = 0; b < blocks; ++b)
-        sampleBlock(s, b * kBlock, std::min(n, (b + 1) * kBlock), blocks_[b]);
+        sampleBlock(s, first + b * kBlock, std::min(n, first + (b + 1) * kBlock), blocks_[b]);
     Sample total;
     for (const Sample& b : blocks_) {
         total.kinetic += b.kinetic;
@@ -135,7 +137,26 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
         }
         if (total.firstBad < 0) total.firstBad = b.firstBad;
     }
+    if (s.domain) reduce(*s.domain, total);
     return total;
+}
+
+// Indices travel as minus themselves so that the maximum finds the lowest (-inf: none).
+void BlowUpGuard::reduce(Domain& domain, Sample& s) {
+    const double none = -std::numeric_limits<double>::infinity();
+    double sums[] = {s.kinetic, s.boundaryPower, s.gravityPower};
+    domain.sum(sums);
+    double maxima[] = {s.maxSpeedSquared, s.maxAbsTheta, s.firstBad >= 0 ? -s.firstBad : none};
+    domain.max(maxima);
+    const double fastest =
+        domain.max(s.maxSpeedSquared == maxima[0] && s.fastest >= 0 ? -s.fastest : none);
+    s = {sums[0],
+         sums[1],
+         sums[2],
+         maxima[0],
+         maxima[1],
+         fastest == none ? -1 : int(-fastest),
+         maxima[2] == none ? -1 : int(-maxima[2])};
 }
 
 void BlowUpGuard::addWork(const State& state, const Sample& s) {

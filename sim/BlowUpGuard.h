@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/Domain.h"
 #include "sim/Params.h"
 
 namespace rend::sim {
@@ -68,6 +69,9 @@ public:
         double time = 0.0, dt = 0.0, stableDt = 0.0;
         bool adaptive = false;      ///< the step came from the adaptive controller (sim/TimeStep.h)
         double colliderWork = 0.0;  ///< at most what moving colliders did on the sheet [J]
+        /// Decomposed (sim/Domain.h): this process samples its slab, and the sums are reduced
+        /// over all of them, so every process decides alike.
+        Domain* domain = nullptr;
     };
     /// Checks the state after a step; throws NumericalBlowUp naming the step, the fastest (or
     /// first non-finite) particle and a suggested dt. `totalEnergy` (kinetic + strain) is
@@ -99,6 +103,7 @@ private:
     void sampleBlock(const State& state, int begin, int end, Sample& out) const;
     [[noreturn]] void report(const State& state, const Sample& s, const std::string& why) const;
     void addWork(const State& state, const Sample& s);
+    static void reduce(Domain& domain, Sample& s);
 
     double safety_ = 0.8;  ///< time.safety, for the advice on adaptive steps
     double speedLimit_ = kLightSpeed;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <unordered_map>
 
 namespace rend::sim {
@@ -69,6 +70,30 @@ BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double hor
         }
     }
     return bonds;
+}
+
+BondPairs buildBondPairs(const BondFamilies& bonds) {
+    const int n = bonds.particleCount();
+    BondPairs pairs;
+    pairs.upperBegin.resize(n);
+    pairs.pairBegin.assign(n + 1, 0);
+    pairs.pairOf.assign(bonds.directedCount(), -1);
+    for (int i = 0; i < n; ++i) {
+        const auto first = bonds.partners.begin() + bonds.offsets[i];
+        const auto last = bonds.partners.begin() + bonds.offsets[i + 1];
+        pairs.upperBegin[i] = int(std::upper_bound(first, last, i) - bonds.partners.begin());
+        pairs.pairBegin[i + 1] = pairs.pairBegin[i] + bonds.offsets[i + 1] - pairs.upperBegin[i];
+    }
+    pairs.twin.assign(pairs.pairBegin[n], -1);
+    for (int i = 0; i < n; ++i)
+        for (int b = pairs.upperBegin[i]; b < bonds.offsets[i + 1]; ++b) {
+            const int u = pairs.pairBegin[i] + b - pairs.upperBegin[i];
+            const int lower = findBond(bonds, bonds.partners[b], i);
+            if (lower < 0) throw std::logic_error("a bond has no copy at its other end");
+            pairs.pairOf[b] = pairs.pairOf[lower] = u;
+            pairs.twin[u] = lower;
+        }
+    return pairs;
 }
 
 }  // namespace rend::sim

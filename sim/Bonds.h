@@ -46,4 +46,23 @@ inline int findBond(const BondFamilies& bonds, int i, int j) {
 /// Every pair closer than `horizon` in the rest configuration, partners sorted by index.
 BondFamilies buildBondFamilies(std::span<const Eigen::Vector3d> rest, double horizon);
 
+/// Each bond once (LAMMPS's half list, "newton on"): pair u joins i < j and is numbered in the
+/// CSR order of its upper copy i -> j, so particle i's pairs are [pairBegin[i], pairBegin[i+1])
+/// and their upper copies [upperBegin[i], offsets[i+1]) of the BondFamilies. A force loop
+/// computes each pair's length once and each particle then gathers its bonds' pair forces in
+/// CSR order: no atomics, and the bits of the loop over both copies.
+struct BondPairs {
+    std::vector<int> upperBegin;  ///< per particle: its first bond to a larger index
+    std::vector<int> pairBegin;   ///< per particle, and one past the last: its first pair
+    std::vector<int> pairOf;      ///< per directed bond: its pair
+    std::vector<int> twin;        ///< per pair: the lower copy j -> i
+
+    int pairCount() const { return int(twin.size()); }
+    /// Whether directed bond b of particle i is its pair's upper copy (i the smaller index).
+    bool isUpper(int i, int b) const { return b >= upperBegin[i]; }
+};
+
+/// The pairs of `bonds`; throws std::logic_error when a bond has no copy at its other end.
+BondPairs buildBondPairs(const BondFamilies& bonds);
+
 }  // namespace rend::sim

@@ -111,8 +111,9 @@ void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
                      std::span<const std::uint8_t> alive, double t, double dt) {
     const int n = int(theta.size());
     scratch_.resize(n);
+    const int first = domain_ ? domain_->slab().begin : 0, last = domain_ ? domain_->slab().end : n;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    for (int i = first; i < last; ++i) {
         double flux = 0.0;
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
             if (alive[b]) flux += rate_[b] * (theta[bonds.partners[b]] - theta[i]);
@@ -123,6 +124,7 @@ void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
         if (t >= spot.start && t < spot.end)
             for (int i : spot.particles) theta[i] += dt * spot.rate;
     for (const auto& [i, value] : held_) theta[i] = value;
+    if (domain_) domain_->exchange(theta.data(), 1);
 }
 
 void Diffusion::advance(std::vector<double>& theta, const BondFamilies& bonds,

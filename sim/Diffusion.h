@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sim/Bonds.h"
+#include "sim/Domain.h"
 #include "sim/Lattice.h"
 #include "sim/Params.h"
 
@@ -44,6 +45,10 @@ public:
 
     std::size_t spotCount() const { return spots_.size(); }
 
+    /// Decomposed runs (sim/Domain.h): advances only its slab's theta, and refreshes the
+    /// ghosts through `domain` after every sub-step.
+    void restrictTo(Domain& domain) { domain_ = &domain; }
+
 private:
     struct Spot {
         double start, end, rate;
@@ -69,6 +74,7 @@ private:
     std::vector<Spot> spots_;
     std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value
     std::vector<double> scratch_;
+    Domain* domain_ = nullptr;
 };
 
 }  // namespace rend::sim

@@ -37,6 +37,7 @@ Membrane::Membrane(const MembraneParams& given)
     setUpNotches(params);
     assignBoundaries();
     x_ = x0_;
+    end_ = n;
     const std::vector<double> heights = perturbationHeights(sheet, x0_);
     for (int i = 0; i < n; ++i) x_[i].z() += heights[i];
     v_.assign(n, Eigen::Vector3d::Zero());
@@ -169,13 +170,13 @@ void Membrane::kick(double h, double tNext) {
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) updateVelocity(i, h, tNext, gravity, damping);
+    for (int i = begin_; i < end_; ++i) updateVelocity(i, h, tNext, gravity, damping);
 }
 
 void Membrane::checkFinite() {
     guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
-                  adaptiveStep_, contact_ ? contact_->takeWork() : 0.0},
-                 [this] { return kineticEnergy() + strainEnergy(); });
+                  adaptiveStep_, contact_ ? contact_->takeWork() : 0.0, domain_},
+                 [this] { return totalEnergy(); });
 }
 
 // Eq. 26 in one pass per particle: velocity, then position. Symplectic Euler is the leapfrog
@@ -200,12 +201,13 @@ void Membrane::integrate(double dt, double tNext) {
         for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
     } else {
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-        for (int i = 0; i < n; ++i) {
+        for (int i = begin_; i < end_; ++i) {
             updateVelocity(i, kickDt, tNext, gravity, damping);
             x_[i] += dt * v_[i];
         }
     }
     collide(tNext);
+    if (domain_) exchangeMotion();
 }
 
 void Membrane::collide(double tNext) {
@@ -218,13 +220,13 @@ void Membrane::collide(double tNext) {
 
 // The ground alone sets no limit: nothing is spent finding the fastest particle for it.
 double Membrane::contactStepLimit() const {
-    return contact_ && contact_->limitsStep() ? contact_->stepLimit(maxSpeed())
+    return contact_ && contact_->limitsStep() ? contact_->stepLimit(slabMaxSpeed())
                                               : std::numeric_limits<double>::infinity();
 }
 
 void Membrane::accumulateForces() {
     solver_->advance(stepState(), *workspace_, force_);
-    stiffening_ = solver_->stiffening();
+    stiffening_ = domain_ ? domain_->max(solver_->stiffening()) : solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
     if (contact_ && contact_->selfContact()) {
         const double t0 = omp_get_wtime();
@@ -311,7 +313,7 @@ void Membrane::step() {
     }
     if (diffusion_) {
         diffusion_->advance(theta_, bonds_, damageState_.bondAlive(), time_,
-                            dt_);  // theta^n -> theta^n+1
+                            dt_);  // theta^n -> theta^n+1 (and its ghosts, decomposed)
         forcesCurrent_ = false;
     }
     if (levelSet_)
@@ -327,7 +329,12 @@ void Membrane::step() {
 
 // Broken bonds, and the triangles element erosion removed (its bonds may stay intact).
 std::size_t Membrane::breakCount() const {
-    return damageState_.brokenBondCount() + damageState_.removedTriangleCount();
+    if (!domain_) return damageState_.brokenBondCount() + damageState_.removedTriangleCount();
+    const std::vector<std::uint8_t>& alive = damageState_.bondAlive();
+    const auto first = alive.begin() + bonds_.offsets[begin_];
+    const auto last = alive.begin() + bonds_.offsets[end_];
+    // Both copies of every broken bond, over all slabs: twice the one process's count.
+    return std::size_t(domain_->sum(double(std::count(first, last, 0)))) / 2;
 }
 
 // The same guard as a fixed step's sub-steps (piecesOfStep): a bond squashed far past what any
@@ -352,7 +359,7 @@ double Membrane::failureApproachRate() const {
     const bool heated = !theta_.empty();
     double fastest = 0.0;  // a maximum: the same for any thread count
 #pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    for (int i = begin_; i < end_; ++i) {
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             const int j = bonds_.partners[b];
             if (j < i || !alive[b]) continue;  // each bond once
@@ -371,7 +378,7 @@ double Membrane::failureApproachRate() const {
             fastest = std::max(fastest, rate / std::max(0.5 * margin, delta * critical));
         }
     }
-    return fastest;
+    return domain_ ? domain_->max(fastest) : fastest;
 }
 
 // The last step of a frame is not clipped to a sliver: the time left is split evenly into as

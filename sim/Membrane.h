@@ -118,6 +118,14 @@ public:
     double kineticEnergy() const;
     double strainEnergy() const;
     double maxSpeed() const;
+
+    /// Steps only the slab `domain` gives this process from now on (sim/Domain.h), kept by
+    /// reference. Throws std::invalid_argument naming what the scene uses that a decomposed run
+    /// does not (another solver, self-contact, remeshing, ...).
+    void decompose(Domain& domain);
+    /// Brings every slab's particles and bonds to process 0, so that its state is the whole
+    /// sheet's (the others keep theirs): between frames, before process 0 writes them.
+    void gatherToFirst();
     double maxTheta() const;  ///< 0 without diffusion
     std::size_t brokenBondCount() const;
     Eigen::Vector3d totalMomentum() const;
@@ -186,6 +194,12 @@ private:
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
     std::size_t breakCount() const;
+    /// Refreshes the ghosts of x and v (decomposed runs only).
+    void exchangeMotion();
+    /// The whole sheet's kinetic plus strain energy, from the slabs (decomposed runs).
+    double totalEnergy() const;
+    /// The fastest particle's speed over all slabs (maxSpeed() where not decomposed).
+    double slabMaxSpeed() const;
     /// saveState's and loadState's fields, in order (sim/MembraneState.cpp).
     template <class Self, class Archive>
     static void visitState(Self& m, Archive& a);
@@ -210,9 +224,11 @@ private:
     std::unique_ptr<Workspace> workspace_;      ///< the solver's scratch for step()
     std::optional<ParticleLevelSet> levelSet_;  ///< params.particleLevelSet, a flat sheet
     std::optional<Remesher> remesher_;          ///< remesh.every > 0
-    double stiffening_ = 1.0;  ///< the solver's worst tangent stiffness over its rest one
-    long subSteps_ = 0;        ///< extra pieces the power law's stiffening asked for
-    double lastDrift_ = 0.0;   ///< the last symplectic Euler drift, 0 before the first
+    Domain* domain_ = nullptr;  ///< decomposed runs: this process's slab and its partners
+    int begin_ = 0, end_ = 0;   ///< the particles this process steps: all, or its slab
+    double stiffening_ = 1.0;   ///< the solver's worst tangent stiffness over its rest one
+    long subSteps_ = 0;         ///< extra pieces the power law's stiffening asked for
+    double lastDrift_ = 0.0;    ///< the last symplectic Euler drift, 0 before the first
     TimeStepController controller_;
     double criticalStretch_ = std::numeric_limits<double>::infinity();
     bool adaptiveStep_ = false;  ///< step() runs inside advanceTo (the guard's advice)

@@ -1,5 +1,7 @@
 #include "sim/PeridynamicBonds.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -7,6 +9,7 @@
 #include <stdexcept>
 
 #include "sim/Fracture.h"
+#include "sim/PairKernels.h"
 #include "sim/Parallel.h"
 #include "sim/SolverRegistry.h"
 
@@ -16,6 +19,7 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
                                    const BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
                                    std::span<const double> volumes)
     : bonds_(bonds),
+      pairs_(buildBondPairs(bonds)),
       rest_(rest),
       volume_(volumes),
       material_(params.material),
@@ -23,6 +27,24 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
     computeBondScales(params, lattice.particleArea);
     setUpFracture(params.material);
     setUpStretchMap(params.materialMaps);
+    setUpPairArrays();
+    const int n = bonds_.particleCount();
+    slab_ = {0, n, 0, n};
+}
+
+void PeridynamicBonds::setUpPairArrays() {
+    if (law_.kind != BondLawKind::Linear) return;
+    const int pairs = pairs_.pairCount();
+    pairFirst_.resize(pairs), pairSecond_.resize(pairs);
+    pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
+    for (int i = 0; i < bonds_.particleCount(); ++i)
+        for (int b = pairs_.upperBegin[i]; b < bonds_.offsets[i + 1]; ++b) {
+            const int u = pairs_.pairOf[b];
+            pairFirst_[u] = i, pairSecond_[u] = bonds_.partners[b];
+            pairRest_[u] = bonds_.restLength[b], pairScale_[u] = bondScale_[b];
+            pairLimit_[u] = criticalStretch_;
+            if (!stretchFactor_.empty()) pairLimit_[u] *= stretchFactor_[b];
+        }
 }
 
 std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
@@ -176,19 +198,28 @@ double PeridynamicBonds::mechanicalStrain(int i, int b, double length,
     return eta - material_.expansion() * thetaBar;
 }
 
-// Writes only particle i's force and its own copies of its bonds (plastic state, proposed
-// break), so the loop needs no atomics. Both copies of a bond see the same strain bit for bit,
-// so they break and yield together; a bond past its limit carries nothing already in this
-// step, so breaking after the loop gives the bits of breaking in place.
+// Two passes in one parallel region. The first computes each pair's force once, from its upper
+// copy i -> j, and writes only that pair's slot and its two copies' plastic state and proposed
+// break; the second sums each particle's pair forces in CSR order, minus where it is the upper
+// index (x_i - x_j = -(x_j - x_i) exactly). So no loop needs atomics, the bits are those of a
+// loop over both copies, and they are the same for any thread count. Both copies of a bond see
+// the same strain bit for bit, so they break and yield together; a bond past its limit carries
+// nothing already in this step, so breaking after the loop gives the bits of breaking in place.
 template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
-void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vector3d>& force,
-                                     Updates& updates) const {
+void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
+                                     std::vector<Eigen::Vector3d>& force, Updates& updates) const {
     const int n = bonds_.particleCount();
     force.resize(n);
+    work.pairForce.resize(pairs_.pairCount());
+    Eigen::Vector3d* pairForce = work.pairForce.data();
     // Raw arrays, loaded once: the stores to `proposed` (a char type) and to `plastic` would
     // otherwise make the compiler reload every vector's data pointer after each of them.
     const int* offsets = bonds_.offsets.data();
     const int* partners = bonds_.partners.data();
+    const int* upperBegin = pairs_.upperBegin.data();
+    const int* pairBegin = pairs_.pairBegin.data();
+    const int* pairOf = pairs_.pairOf.data();
+    const int* twin = pairs_.twin.data();
     const double* restLength = bonds_.restLength.data();
     const double* bondScale = bondScale_.data();
     const double* stretchFactor = stretchFactor_.empty() ? nullptr : stretchFactor_.data();
@@ -205,73 +236,150 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, std::vector<Eigen::Vect
     const double expansion = material_.expansion();
     double stiffest = 1.0;  // the stiffest compressed bond's tangent over c, for the power law
     int breaking = 0;
-#pragma omp parallel for schedule(static) reduction(max : stiffest) reduction(+ : breaking) if ( \
-        n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        const Eigen::Vector3d xi = xs[i];
-        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
-            if (!alive[b]) continue;
-            const int j = partners[b];
-            const Eigen::Vector3d r = xs[j] - xi;
-            const double length = r.norm();
-            double eta = length / restLength[b] - 1.0;  // eq. 10
-            double thetaBar = 0.0;
-            if constexpr (kTheta) {  // see mechanicalStrain()
-                thetaBar = 0.5 * (theta[i] + theta[j]);
-                eta -= expansion * thetaBar;
-            }
-            if constexpr (kBreak) {  // eq. 27/28
-                double limit = criticalStretch_;
-                if (stretchFactor) limit *= stretchFactor[b];
-                if constexpr (kTheta) limit *= material_.strengthFactor(thetaBar);
-                if (eta > limit) {
-                    if constexpr (kUpdateBonds) proposed[b] = 1, ++breaking;
-                    continue;
-                }
-            }
-            PlasticState state;
-            double yield = 1.0;  // eta0's factor: the law runs in units of the bond's own eta0
-            if constexpr (kLaw == BondLawKind::Elastoplastic) {
-                if (yieldFactor) yield = yieldFactor[b];
-                state = law_.yieldStep(eta / yield, plasticIn[b]);
-                if constexpr (kUpdateBonds) plastic[b] = state;
-            }
-            if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
-                if (eta < 0.0) {  // its tangent where it will be in dt, if it closes
-                    const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
-                    const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
-                    double tangent = ownLaws ? lawOf(b).powerLawStiffening(ahead)
-                                             : law_.powerLawStiffening(ahead);
-                    // A dissolved bond (theta past 1 / stiffness_loss) is squashed by its own
-                    // swelling, yet carries no force: only the stiffness it has counts.
-                    if constexpr (kTheta) tangent *= material_.stiffnessFactor(thetaBar);
-                    stiffest = std::max(stiffest, tangent);
-                }
-            }
-            // A copy of the law only where maps give this bond its own.
-            double f = ownLaws ? yield * lawOf(b).template forceAs<kLaw>(eta / yield, state)
-                               : yield * law_.template forceAs<kLaw>(eta / yield, state);
-            if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
-            sum += (bondScale[b] * f / length) * r;
+    // Pair u = (i, j) through its upper copy b: its force on i, or zero where it carries none.
+    auto pairForceOf = [&](int i, const Eigen::Vector3d& xi, int b, int u) -> Eigen::Vector3d {
+        if (!alive[b]) return Eigen::Vector3d::Zero();
+        const int j = partners[b];
+        const Eigen::Vector3d r = xs[j] - xi;
+        const double length = r.norm();
+        double eta = length / restLength[b] - 1.0;  // eq. 10
+        double thetaBar = 0.0;
+        if constexpr (kTheta) {  // see mechanicalStrain()
+            thetaBar = 0.5 * (theta[i] + theta[j]);
+            eta -= expansion * thetaBar;
         }
-        force[i] = sum;
+        if constexpr (kBreak) {  // eq. 27/28
+            double limit = criticalStretch_;
+            if (stretchFactor) limit *= stretchFactor[b];
+            if constexpr (kTheta) limit *= material_.strengthFactor(thetaBar);
+            if (eta > limit) {
+                if constexpr (kUpdateBonds) proposed[b] = proposed[twin[u]] = 1, breaking += 2;
+                return Eigen::Vector3d::Zero();
+            }
+        }
+        PlasticState state;
+        double yield = 1.0;  // eta0's factor: the law runs in units of the bond's own eta0
+        if constexpr (kLaw == BondLawKind::Elastoplastic) {
+            if (yieldFactor) yield = yieldFactor[b];
+            state = law_.yieldStep(eta / yield, plasticIn[b]);
+            if constexpr (kUpdateBonds) plastic[b] = plastic[twin[u]] = state;
+        }
+        if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
+            if (eta < 0.0) {  // its tangent where it will be in dt, if it closes
+                const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
+                const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
+                double tangent =
+                    ownLaws ? lawOf(b).powerLawStiffening(ahead) : law_.powerLawStiffening(ahead);
+                // A dissolved bond (theta past 1 / stiffness_loss) is squashed by its own
+                // swelling, yet carries no force: only the stiffness it has counts.
+                if constexpr (kTheta) tangent *= material_.stiffnessFactor(thetaBar);
+                stiffest = std::max(stiffest, tangent);
+            }
+        }
+        // A copy of the law only where maps give this bond its own.
+        double f = ownLaws ? yield * lawOf(b).template forceAs<kLaw>(eta / yield, state)
+                           : yield * law_.template forceAs<kLaw>(eta / yield, state);
+        if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
+        return (bondScale[b] * f / length) * r;
+    };
+#pragma omp parallel if (n >= kParallelThreshold)
+    {
+#pragma omp for schedule(static) reduction(max : stiffest) reduction(+ : breaking)
+        for (int i = slab_.ghostBegin; i < slab_.end; ++i) {
+            const Eigen::Vector3d xi = xs[i];
+            for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
+                pairForce[u] = pairForceOf(i, xi, b, u);
+        }
+#pragma omp for schedule(static)
+        for (int i = slab_.begin; i < slab_.end; ++i) {
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+            for (int b = offsets[i]; b < upperBegin[i]; ++b) sum -= pairForce[pairOf[b]];
+            for (int u = pairBegin[i]; u < pairBegin[i + 1]; ++u) sum += pairForce[u];
+            force[i] = sum;
+        }
     }
     updates.breaking = breaking;
     updates.stiffest = stiffest;
 }
 
+template <bool kUpdateBonds, bool kBreak>
+void PeridynamicBonds::linearBondForces(const StepState& s, PairWorkspace& work,
+                                        std::vector<Eigen::Vector3d>& force,
+                                        Updates& updates) const {
+    const int n = bonds_.particleCount(), pairs = pairs_.pairCount();
+    force.resize(n);
+    work.fx.resize(pairs), work.fy.resize(pairs), work.fz.resize(pairs);
+    if (kBreak) work.over.resize(pairs);
+    const LinearPairInput in{pairFirst_.data(),
+                             pairSecond_.data(),
+                             pairRest_.data(),
+                             pairScale_.data(),
+                             kBreak ? pairLimit_.data() : nullptr,
+                             s.x.data()->data(),
+                             s.theta.empty() ? nullptr : s.theta.data(),
+                             law_.c,
+                             material_.expansion(),
+                             material_.params().stiffnessLoss,
+                             material_.params().strengthLoss};
+    const LinearPairOutput out{work.fx.data(), work.fy.data(), work.fz.data(), work.over.data()};
+    const int* offsets = bonds_.offsets.data();
+    const int* upperBegin = pairs_.upperBegin.data();
+    const int* pairBegin = pairs_.pairBegin.data();
+    const int* pairOf = pairs_.pairOf.data();
+    const int* twin = pairs_.twin.data();
+    const std::uint8_t* alive = damage_->bondAlive().data();
+    const std::uint8_t* over = work.over.data();
+    std::uint8_t* proposed = updates.proposed;
+    const double *fx = out.fx, *fy = out.fy, *fz = out.fz;
+    int breaking = 0;
+#pragma omp parallel if (n >= kParallelThreshold)
+    {
+        const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+        const std::int64_t first = pairBegin[slab_.ghostBegin],
+                           count = pairBegin[slab_.end] - first;
+        linearPairForces(in, out, int(first + count * t / threads),
+                         int(first + count * (t + 1) / threads));
+#pragma omp barrier
+#pragma omp for schedule(static) reduction(+ : breaking)
+        for (int i = slab_.begin; i < slab_.end; ++i) {
+            double sx = 0.0, sy = 0.0, sz = 0.0;
+            for (int b = offsets[i]; b < upperBegin[i]; ++b)
+                if (alive[b]) {
+                    const int u = pairOf[b];
+                    sx -= fx[u], sy -= fy[u], sz -= fz[u];
+                }
+            for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
+                if (alive[b]) {
+                    sx += fx[u], sy += fy[u], sz += fz[u];
+                    if constexpr (kUpdateBonds && kBreak)
+                        if (over[u]) proposed[b] = proposed[twin[u]] = 1, breaking += 2;
+                }
+            force[i] = Eigen::Vector3d(sx, sy, sz);
+        }
+    }
+    updates.breaking = breaking;
+}
+
 template <bool kUpdateBonds>
-void PeridynamicBonds::bondForces(const StepState& s, std::vector<Eigen::Vector3d>& force,
-                                  Updates& updates) const {
+void PeridynamicBonds::bondForces(const StepState& s, Workspace& work,
+                                  std::vector<Eigen::Vector3d>& force, Updates& updates) const {
+    PairWorkspace& pairs = static_cast<PairWorkspace&>(work);
+    if (law_.kind == BondLawKind::Linear) {
+        if (std::isfinite(criticalStretch_))
+            return linearBondForces<kUpdateBonds, true>(s, pairs, force, updates);
+        return linearBondForces<kUpdateBonds, false>(s, pairs, force, updates);
+    }
     const bool theta = !s.theta.empty();
     const bool breakable = std::isfinite(criticalStretch_);
     auto forLaw = [&]<BondLawKind kLaw>() {
-        if (theta && breakable) bondForcesFor<kUpdateBonds, kLaw, true, true>(s, force, updates);
-        if (theta && !breakable) bondForcesFor<kUpdateBonds, kLaw, true, false>(s, force, updates);
-        if (!theta && breakable) bondForcesFor<kUpdateBonds, kLaw, false, true>(s, force, updates);
+        if (theta && breakable)
+            bondForcesFor<kUpdateBonds, kLaw, true, true>(s, pairs, force, updates);
+        if (theta && !breakable)
+            bondForcesFor<kUpdateBonds, kLaw, true, false>(s, pairs, force, updates);
+        if (!theta && breakable)
+            bondForcesFor<kUpdateBonds, kLaw, false, true>(s, pairs, force, updates);
         if (!theta && !breakable)
-            bondForcesFor<kUpdateBonds, kLaw, false, false>(s, force, updates);
+            bondForcesFor<kUpdateBonds, kLaw, false, false>(s, pairs, force, updates);
     };
     switch (law_.kind) {
         case BondLawKind::Linear:
@@ -283,16 +391,16 @@ void PeridynamicBonds::bondForces(const StepState& s, std::vector<Eigen::Vector3
     }
 }
 
-void PeridynamicBonds::forces(const StepState& s, Workspace&,
+void PeridynamicBonds::forces(const StepState& s, Workspace& work,
                               std::vector<Eigen::Vector3d>& force) const {
     Updates none;
-    bondForces<false>(s, force, none);
+    bondForces<false>(s, work, force, none);
 }
 
-void PeridynamicBonds::advance(const StepState& s, Workspace&,
+void PeridynamicBonds::advance(const StepState& s, Workspace& work,
                                std::vector<Eigen::Vector3d>& force) {
     Updates updates{plastic_.data(), damage_->proposals()};
-    bondForces<true>(s, force, updates);
+    bondForces<true>(s, work, force, updates);
     if (updates.breaking > 0) damage_->applyProposals();
     if (law_.kind == BondLawKind::PowerLaw) stiffening_ = updates.stiffest;
 }
@@ -303,9 +411,13 @@ void PeridynamicBonds::reportStrength(DamageState& damage) const {
 }
 
 double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
+    return strainEnergyOf(s, 0, bonds_.particleCount());
+}
+
+double PeridynamicBonds::strainEnergyOf(const StepState& s, int begin, int end) const {
     const auto& x = s.x;
     double sum = 0.0;
-    for (int i = 0; i < bonds_.particleCount(); ++i)
+    for (int i = begin; i < end; ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             if (!damage_->bondAlive()[b]) continue;
             double thetaBar;

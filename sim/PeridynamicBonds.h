@@ -35,6 +35,9 @@ public:
     /// The registry's factory (sim/SolverRegistry.h).
     static std::unique_ptr<Solver> make(const SolverSetUp& s);
 
+    std::unique_ptr<Workspace> makeWorkspace() const override {
+        return std::make_unique<PairWorkspace>();
+    }
     void forces(const StepState& s, Workspace& work,
                 std::vector<Eigen::Vector3d>& force) const override;
     void advance(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force) override;
@@ -44,8 +47,20 @@ public:
     void saveState(StateWriter& out) const override { out(plastic_), out(stiffening_); }
     void loadState(StateReader& in) override { in(plastic_), in(stiffening_); }
     void reportStrength(DamageState& damage) const override;
+    bool restrictTo(const Slab& slab) override {
+        slab_ = slab;
+        return true;
+    }
+    /// The strain energy of the bonds of the particles of its slab (half of each bond's).
+    double slabStrainEnergy(const StepState& s) const {
+        return strainEnergyOf(s, slab_.begin, slab_.end);
+    }
+    /// Per directed bond, the elastoplastic law's history (empty for the other laws).
+    std::vector<PlasticState>& plasticState() { return plastic_; }
 
     const BondLaw& law() const { return law_; }
+    /// Directed bond b's force on its particle per unit of f(eta) (sim/BondLaw.h).
+    double bondScale(int b) const { return bondScale_[b]; }
     /// eta_c at theta = 0; +infinity when the material has no fracture energy.
     double criticalStretch() const { return criticalStretch_; }
     /// Virial (Cauchy-like) stress of particle i at s.x: 1/(2 V_i) sum_j F_ij (x) r_ij.
@@ -70,18 +85,36 @@ private:
         int breaking = 0;       ///< out: the bonds proposed
         double stiffest = 1.0;  ///< out: the largest look-ahead tangent x stiffness factor, over c
     };
+    /// The scratch of the force loop: each pair's force on its smaller index (the linear law's
+    /// as three arrays, and whether it is past its limit).
+    struct PairWorkspace : Workspace {
+        std::vector<Eigen::Vector3d> pairForce;
+        std::vector<double> fx, fy, fz;
+        std::vector<std::uint8_t> over;
+    };
+    /// The linear law's loop: sim/PairKernels.h's first pass, then the gather.
+    template <bool kUpdateBonds, bool kBreak>
+    void linearBondForces(const StepState& s, PairWorkspace& work,
+                          std::vector<Eigen::Vector3d>& force, Updates& updates) const;
+    void setUpPairArrays();
+    double strainEnergyOf(const StepState& s, int begin, int end) const;
     /// The force loop for the scene's law.
     template <bool kUpdateBonds>
-    void bondForces(const StepState& s, std::vector<Eigen::Vector3d>& force,
+    void bondForces(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force,
                     Updates& updates) const;
     template <bool kUpdateBonds, BondLawKind kLaw, bool kTheta, bool kBreak>
-    void bondForcesFor(const StepState& s, std::vector<Eigen::Vector3d>& force,
+    void bondForcesFor(const StepState& s, PairWorkspace& work, std::vector<Eigen::Vector3d>& force,
                        Updates& updates) const;
     /// Mechanical strain of bond b of particle i (diffusion strain removed) and its theta_bar.
     double mechanicalStrain(int i, int b, double length, std::span<const double> theta,
                             double& thetaBar) const;
 
     const BondFamilies& bonds_;
+    BondPairs pairs_;  ///< each bond once, for the force loop
+    /// Per pair, for the linear law's vectorised pass: its ends, rest length, bond scale and
+    /// critical stretch (sim/PairKernels.h).
+    std::vector<int> pairFirst_, pairSecond_;
+    std::vector<double> pairRest_, pairScale_, pairLimit_;
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     Material material_;
@@ -106,6 +139,7 @@ private:
         return law_.scaled(at(softeningFactor_), at(ratioFactor_), at(exponentFactor_));
     }
     double stiffening_ = 1.0;  ///< the most compressed bond's, over c (advance() only)
+    Slab slab_;                ///< what this process computes; all of the sheet by default
 };
 
 }  // namespace rend::sim

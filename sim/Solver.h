@@ -23,6 +23,7 @@
 
 #include "sim/Bonds.h"
 #include "sim/DamageState.h"
+#include "sim/Domain.h"
 #include "sim/StateArchive.h"
 
 namespace rend::sim {
@@ -120,6 +121,11 @@ public:
     /// Carries the notches into the solver's own pieces at set-up: the DamageState already has
     /// the bonds {i, j} in `edges` broken (and their edges).
     virtual void cut(const std::vector<std::array<int, 2>>& edges) {}
+
+    /// From now on computes only what slab `slab` needs (sim/Domain.h): the forces on its own
+    /// particles, the updates of their bonds, and its share of the strain energy. False where
+    /// the solver cannot.
+    virtual bool restrictTo(const Slab& slab) { return false; }
 
     // Conveniences for tests and tools: one call at x (theta none) with a fresh workspace.
     std::vector<Eigen::Vector3d> forcesAt(std::span<const Eigen::Vector3d> x) const {

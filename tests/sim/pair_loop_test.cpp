@@ -1,0 +1,160 @@
+// The force loop over each bond once (sim/Bonds.h's BondPairs, sim/PairKernels.h) gives the
+// bits of the loop over both copies of every bond, for every law, with theta and breaking.
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+#include "sim/Domain.h"
+#include "sim/Material.h"
+#include "sim/PeridynamicBonds.h"
+#include "sim/Random.h"
+
+using namespace rend::sim;
+
+namespace {
+
+TEST(BondPairs, NumberEachBondOnceThroughItsUpperCopy) {
+    SheetParams sheet;
+    sheet.size = {0.2, 0.1};
+    sheet.dx = 0.01;
+    const Lattice lattice = generateLattice(sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 2.5 * sheet.dx);
+    const BondPairs pairs = buildBondPairs(bonds);
+    ASSERT_EQ(std::size_t(pairs.pairCount()), bonds.bondCount());
+    std::vector<int> seen(pairs.pairCount(), 0);
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            const int j = bonds.partners[b], u = pairs.pairOf[b];
+            ++seen[u];
+            EXPECT_EQ(pairs.isUpper(i, b), j > i);
+            if (j > i) {
+                EXPECT_EQ(u, pairs.pairBegin[i] + b - pairs.upperBegin[i]);
+                EXPECT_EQ(bonds.partners[pairs.twin[u]], i);
+            } else {
+                EXPECT_EQ(pairs.twin[u], b);
+            }
+        }
+    for (int u = 0; u < pairs.pairCount(); ++u) EXPECT_EQ(seen[u], 2) << u;
+}
+
+struct Case {
+    BondLawKind law;
+    bool theta, breakable;
+};
+
+/// Particle i's force summed over both copies of its bonds, one at a time: the loop as the
+/// paper writes it (eqs. 10, 18-20, 27-28).
+std::vector<Eigen::Vector3d> bothCopies(const PeridynamicBonds& solver, const BondFamilies& bonds,
+                                        const DamageState& damage, const MaterialParams& m,
+                                        const std::vector<Eigen::Vector3d>& x,
+                                        const std::vector<double>& theta) {
+    const Material material(m);
+    std::vector<Eigen::Vector3d> force(x.size(), Eigen::Vector3d::Zero());
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            if (!damage.bondAlive()[b]) continue;
+            const int j = bonds.partners[b];
+            const Eigen::Vector3d r = x[j] - x[i];
+            const double length = r.norm();
+            double eta = length / bonds.restLength[b] - 1.0;
+            const double thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[i] + theta[j]);
+            if (!theta.empty()) eta -= material.expansion() * thetaBar;
+            if (eta > solver.criticalStretch() * material.strengthFactor(thetaBar)) continue;
+            const BondLaw& law = solver.law();
+            double f = law.force(eta, law.yieldStep(eta, {}));
+            if (!theta.empty()) f *= material.stiffnessFactor(thetaBar);
+            force[i] += (solver.bondScale(b) * f / length) * r;
+        }
+    return force;
+}
+
+class PairLoop : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
+    const Case c = GetParam();
+    MembraneParams p;
+    p.sheet.size = {0.2, 0.1};
+    p.sheet.dx = 0.01;
+    p.material.youngsModulus = 1e5;
+    p.material.law = c.law;
+    p.material.yieldStrain = 0.002;
+    if (c.breakable) p.material.fractureEnergy = 0.02;
+    if (c.theta)
+        p.material.expansion = 0.01, p.material.stiffnessLoss = 0.4, p.material.strengthLoss = 0.3;
+    const Lattice lattice = generateLattice(p.sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 2.0 * p.sheet.dx);
+    p.sheet.horizonFactor = 2.0;
+    const std::vector<double> volumes(lattice.positions.size(),
+                                      lattice.particleArea * p.sheet.thickness);
+    PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
+    DamageState damage(bonds, lattice.triangles);
+    solver.bind(bonds, damage);
+    for (int b = 0; b < int(bonds.directedCount()); b += 37) damage.breakBond(b);  // some dead
+
+    const int n = int(lattice.positions.size());
+    std::vector<Eigen::Vector3d> x = lattice.positions, v(n, Eigen::Vector3d::Zero());
+    std::vector<double> theta;
+    const double etaC = std::isfinite(solver.criticalStretch()) ? solver.criticalStretch() : 0.01;
+    for (int i = 0; i < n; ++i) {  // strains up to twice eta_c either way
+        for (int a = 0; a < 3; ++a)
+            x[i][a] += 2.0 * etaC * p.sheet.dx * (2.0 * uniformFromHash(7, 3 * i + a) - 1.0);
+        if (c.theta) theta.push_back(2.0 * uniformFromHash(8, i));
+    }
+    std::vector<Eigen::Vector3d> force;
+    solver.forces({x, v, theta, 1e-4}, *solver.makeWorkspace(), force);
+    const std::vector<Eigen::Vector3d> expected =
+        bothCopies(solver, bonds, damage, p.material, x, theta);
+    ASSERT_EQ(force.size(), expected.size());
+    EXPECT_EQ(std::memcmp(force.data(), expected.data(), n * sizeof(Eigen::Vector3d)), 0);
+    int differ = 0;
+    for (int i = 0; i < n; ++i) differ += force[i] != expected[i];
+    EXPECT_EQ(differ, 0) << "of " << n << " particles";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
+                         ::testing::Values(Case{BondLawKind::Linear, false, false},
+                                           Case{BondLawKind::Linear, true, true},
+                                           Case{BondLawKind::Linear, false, true},
+                                           Case{BondLawKind::Linear, true, false},
+                                           Case{BondLawKind::PowerLaw, false, false},
+                                           Case{BondLawKind::PowerLaw, true, true},
+                                           Case{BondLawKind::Elastoplastic, false, true},
+                                           Case{BondLawKind::Elastoplastic, true, true}));
+
+}  // namespace
+
+namespace {
+
+TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
+    SheetParams sheet;
+    sheet.size = {0.3, 0.2};
+    sheet.dx = 0.01;
+    const Lattice lattice = generateLattice(sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * sheet.dx);
+    const int n = bonds.particleCount();
+    for (const int count : {1, 2, 3, 7}) {
+        const std::vector<Slab> slabs = partitionSlabs(bonds, count);
+        ASSERT_EQ(int(slabs.size()), count);
+        EXPECT_EQ(slabs.front().begin, 0);
+        EXPECT_EQ(slabs.back().end, n);
+        for (int r = 0; r < count; ++r) {
+            const Slab& s = slabs[r];
+            if (r > 0) EXPECT_EQ(s.begin, slabs[r - 1].end);
+            // Every pair from [ghostBegin, end) and every owned particle's partner is held.
+            for (int i = s.ghostBegin; i < s.end; ++i)
+                for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+                    const int j = bonds.partners[b];
+                    if (i >= s.begin || j > i) {
+                        EXPECT_GE(j, s.ghostBegin);
+                        EXPECT_LT(j, s.ghostEnd);
+                    }
+                }
+            if (r > 0) EXPECT_GE(s.ghostBegin, slabs[r - 1].begin) << "only the next slab";
+        }
+    }
+    EXPECT_THROW(partitionSlabs(bonds, n / 10), std::invalid_argument) << "slabs of 10";
+}
+
+}  // namespace

@@ -8,18 +8,28 @@
 namespace rend::sim {
 namespace {
 
-// One loop per stage a scene needs, so each vectorises without a branch inside. The expressions
-// are those of the scalar loop (PeridynamicBonds::bondForcesFor) term by term: the same bits.
-template <bool kTheta, bool kBreak>
-inline void pairLoop(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
+constexpr double kMostCompression = -0.95;  // BondLaw::kMostCompression
+
+/// BondLaw::power for the whole exponents the kernels take (0 to 3).
+inline double wholePower(double s, double k) {
+    if (k == 0.0) return 1.0;
+    if (k == 1.0) return s;
+    if (k == 2.0) return s * s;
+    return s * s * s;
+}
+
+// One loop per stage a scene needs, so each runs without a branch it does not need. The
+// expressions are those of the scalar loop (PeridynamicBonds::bondForcesFor, BondLaw)
+// term by term: the same bits.
+template <bool kPower, bool kTheta, bool kBreak, bool kLook>
+inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     const int* __restrict first = in.first;
     const int* __restrict second = in.second;
     const double* __restrict x = in.x;
     const double* __restrict theta = in.theta;
-    double* __restrict fx = out.fx;
-    double* __restrict fy = out.fy;
-    double* __restrict fz = out.fz;
+    double* __restrict force = out.force;
     std::uint8_t* __restrict over = out.over;
+    double stiffest = 1.0;
     for (int u = begin; u < end; ++u) {
         const int i = first[u], j = second[u];
         const double rx = x[3 * j] - x[3 * i];
@@ -32,19 +42,57 @@ inline void pairLoop(const LinearPairInput& in, const LinearPairOutput& out, int
             thetaBar = 0.5 * (theta[i] + theta[j]);
             eta -= in.expansion * thetaBar;
         }
-        f = in.c * eta;  // eq. 18
-        if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
-        double coef = in.scale[u] * f / length;
+        bool past = false;
         if constexpr (kBreak) {  // eqs. 27-28
             double limit = in.limit[u];
             if constexpr (kTheta) limit *= std::max(0.0, 1.0 - in.strengthLoss * thetaBar);
-            const bool past = eta > limit;
+            past = eta > limit;
             over[u] = past;
-            coef = past ? 0.0 : coef;
         }
-        fx[u] = coef * rx;
-        fy[u] = coef * ry;
-        fz[u] = coef * rz;
+        if constexpr (kPower) {  // eq. 19, and the tangent where the bond will be in dt
+            if (kLook && eta < 0.0 && !past && in.alive[in.upper[u]]) {
+                const double* v = in.v;
+                const double rate =
+                    (rx * (v[3 * j] - v[3 * i]) + ry * (v[3 * j + 1] - v[3 * i + 1]) +
+                     rz * (v[3 * j + 2] - v[3 * i + 2])) /
+                    (length * in.restLength[u]);
+                const double s =
+                    1.0 + std::max(eta + std::min(0.0, in.dt * rate), kMostCompression);
+                const double s2 = s * s;
+                double tangent = (2.0 * in.powerC * (1.0 + 3.0 / (s2 * s2)) +
+                                  in.powerCStar * in.powerN * (in.powerN - 1.0) *
+                                      wholePower(s, in.powerN - 2.0)) /
+                                 in.c;
+                if constexpr (kTheta) tangent *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
+                stiffest = std::max(stiffest, tangent);
+            }
+            const double s = 1.0 + std::max(eta, kMostCompression);
+            f = 2.0 * in.powerC * (s - 1.0 / (s * s * s)) +
+                in.powerCStar * in.powerN * (wholePower(s, in.powerN - 1.0) - 1.0);
+        } else {
+            f = in.c * eta;  // eq. 18
+        }
+        if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
+        double coef = in.scale[u] * f / length;
+        if constexpr (kBreak) coef = past ? 0.0 : coef;
+        force[4 * u] = coef * rx;
+        force[4 * u + 1] = coef * ry;
+        force[4 * u + 2] = coef * rz;
+        force[4 * u + 3] = 0.0;
+    }
+    return stiffest;
+}
+
+void gatherLoop(const PairGather& g, int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+        double sum[3] = {0.0, 0.0, 0.0};
+        for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
+            if (g.alive[b])
+                for (int k = 0; k < 3; ++k) sum[k] -= g.pairForce[4 * g.pairOf[b] + k];
+        for (int b = g.upperBegin[i], u = g.pairBegin[i]; b < g.offsets[i + 1]; ++b, ++u)
+            if (g.alive[b])
+                for (int k = 0; k < 3; ++k) sum[k] += g.pairForce[4 * u + k];
+        for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
     }
 }
 
@@ -66,15 +114,29 @@ struct Lanes {
             _mm256_set_pd(d[2], c[2], b[2], a[2])};
 }
 
-// Four pairs at a time: the same operations in the same order, four lanes wide.
-template <bool kTheta, bool kBreak>
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256d wholePower4(__m256d s, double k) {
+    if (k == 0.0) return _mm256_set1_pd(1.0);
+    if (k == 1.0) return s;
+    if (k == 2.0) return _mm256_mul_pd(s, s);
+    return _mm256_mul_pd(_mm256_mul_pd(s, s), s);
+}
+
+// Four pairs at a time: the same operations in the same order, four lanes wide. The maxima and
+// minima take their arguments in the order that gives std::max and std::min's answer for NaN.
+template <bool kPower, bool kTheta, bool kBreak, bool kLook>
 [[gnu::target("avx2")]] int pairLoopAvx2(const LinearPairInput& in, const LinearPairOutput& out,
-                                         int begin, int end) {
+                                         int begin, int end, double& stiffest) {
     const __m256d one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
     const __m256d half = _mm256_set1_pd(0.5), c = _mm256_set1_pd(in.c);
     const __m256d expansion = _mm256_set1_pd(in.expansion);
     const __m256d stiffnessLoss = _mm256_set1_pd(in.stiffnessLoss);
     const __m256d strengthLoss = _mm256_set1_pd(in.strengthLoss);
+    const __m256d most = _mm256_set1_pd(kMostCompression), dt = _mm256_set1_pd(in.dt);
+    const __m256d twoC = _mm256_set1_pd(2.0 * in.powerC);
+    const __m256d starN = _mm256_set1_pd(in.powerCStar * in.powerN);
+    const __m256d starNN = _mm256_set1_pd(in.powerCStar * in.powerN * (in.powerN - 1.0));
+    const __m256d three = _mm256_set1_pd(3.0);
+    __m256d stiffest4 = one;
     int u = begin;
     for (; u + 4 <= end; u += 4) {
         const __m128i i = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in.first + u));
@@ -86,34 +148,97 @@ template <bool kTheta, bool kBreak>
         const __m256d squared = _mm256_add_pd(
             _mm256_add_pd(_mm256_mul_pd(rx, rx), _mm256_mul_pd(ry, ry)), _mm256_mul_pd(rz, rz));
         const __m256d length = _mm256_sqrt_pd(squared);
-        __m256d eta = _mm256_sub_pd(_mm256_div_pd(length, _mm256_loadu_pd(in.restLength + u)), one);
-        __m256d thetaBar = zero;
+        const __m256d rest = _mm256_loadu_pd(in.restLength + u);
+        __m256d eta = _mm256_sub_pd(_mm256_div_pd(length, rest), one);
+        __m256d thetaBar = zero, stiffness = one;
         if constexpr (kTheta) {
             thetaBar = _mm256_mul_pd(half, _mm256_add_pd(_mm256_i32gather_pd(in.theta, i, 8),
                                                          _mm256_i32gather_pd(in.theta, j, 8)));
             eta = _mm256_sub_pd(eta, _mm256_mul_pd(expansion, thetaBar));
+            stiffness = _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(stiffnessLoss, thetaBar)),
+                                      zero);  // max(0, 1 - loss theta)
         }
-        __m256d f = _mm256_mul_pd(c, eta);
-        if constexpr (kTheta)  // times max(0, 1 - loss theta)
-            f = _mm256_mul_pd(
-                f, _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(stiffnessLoss, thetaBar)), zero));
-        __m256d coef = _mm256_div_pd(_mm256_mul_pd(_mm256_loadu_pd(in.scale + u), f), length);
+        __m256d past = zero;
         if constexpr (kBreak) {
             __m256d limit = _mm256_loadu_pd(in.limit + u);
             if constexpr (kTheta)
                 limit = _mm256_mul_pd(
                     limit,
                     _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(strengthLoss, thetaBar)), zero));
-            const __m256d past = _mm256_cmp_pd(eta, limit, _CMP_GT_OQ);
+            past = _mm256_cmp_pd(eta, limit, _CMP_GT_OQ);
             const int bits = _mm256_movemask_pd(past);
             for (int k = 0; k < 4; ++k) out.over[u + k] = (bits >> k) & 1;
-            coef = _mm256_blendv_pd(coef, zero, past);
         }
-        _mm256_storeu_pd(out.fx + u, _mm256_mul_pd(coef, rx));
-        _mm256_storeu_pd(out.fy + u, _mm256_mul_pd(coef, ry));
-        _mm256_storeu_pd(out.fz + u, _mm256_mul_pd(coef, rz));
+        __m256d f;
+        if constexpr (kPower) {
+            if constexpr (kLook) {
+                const Lanes vi = loadPositions(in.v, in.first + u);
+                const Lanes vj = loadPositions(in.v, in.second + u);
+                const __m256d dot =
+                    _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx, _mm256_sub_pd(vj.x, vi.x)),
+                                                _mm256_mul_pd(ry, _mm256_sub_pd(vj.y, vi.y))),
+                                  _mm256_mul_pd(rz, _mm256_sub_pd(vj.z, vi.z)));
+                const __m256d rate = _mm256_div_pd(dot, _mm256_mul_pd(length, rest));
+                const __m256d ahead = _mm256_max_pd(
+                    most, _mm256_add_pd(eta, _mm256_min_pd(_mm256_mul_pd(dt, rate), zero)));
+                const __m256d s = _mm256_add_pd(one, ahead), s2 = _mm256_mul_pd(s, s);
+                __m256d tangent = _mm256_div_pd(
+                    _mm256_add_pd(
+                        _mm256_mul_pd(
+                            twoC, _mm256_add_pd(one, _mm256_div_pd(three, _mm256_mul_pd(s2, s2)))),
+                        _mm256_mul_pd(starNN, wholePower4(s, in.powerN - 2.0))),
+                    c);
+                if constexpr (kTheta) tangent = _mm256_mul_pd(tangent, stiffness);
+                const int* upper = in.upper + u;
+                const __m256d alive = _mm256_set_pd(in.alive[upper[3]], in.alive[upper[2]],
+                                                    in.alive[upper[1]], in.alive[upper[0]]);
+                const __m256d counts =
+                    _mm256_and_pd(_mm256_andnot_pd(past, _mm256_cmp_pd(eta, zero, _CMP_LT_OQ)),
+                                  _mm256_cmp_pd(alive, zero, _CMP_NEQ_OQ));
+                stiffest4 = _mm256_max_pd(_mm256_blendv_pd(one, tangent, counts), stiffest4);
+            }
+            const __m256d s = _mm256_add_pd(one, _mm256_max_pd(most, eta));
+            f = _mm256_add_pd(
+                _mm256_mul_pd(
+                    twoC,
+                    _mm256_sub_pd(s, _mm256_div_pd(one, _mm256_mul_pd(_mm256_mul_pd(s, s), s)))),
+                _mm256_mul_pd(starN, _mm256_sub_pd(wholePower4(s, in.powerN - 1.0), one)));
+        } else {
+            f = _mm256_mul_pd(c, eta);
+        }
+        if constexpr (kTheta) f = _mm256_mul_pd(f, stiffness);
+        __m256d coef = _mm256_div_pd(_mm256_mul_pd(_mm256_loadu_pd(in.scale + u), f), length);
+        if constexpr (kBreak) coef = _mm256_blendv_pd(coef, zero, past);
+        // Four x y z 0 slots from the three lanes of x, of y and of z.
+        const __m256d fx = _mm256_mul_pd(coef, rx), fy = _mm256_mul_pd(coef, ry);
+        const __m256d fz = _mm256_mul_pd(coef, rz);
+        const __m256d xy02 = _mm256_unpacklo_pd(fx, fy), xy13 = _mm256_unpackhi_pd(fx, fy);
+        const __m256d z02 = _mm256_unpacklo_pd(fz, zero), z13 = _mm256_unpackhi_pd(fz, zero);
+        double* slot = out.force + 4 * std::size_t(u);
+        _mm256_storeu_pd(slot, _mm256_permute2f128_pd(xy02, z02, 0x20));
+        _mm256_storeu_pd(slot + 4, _mm256_permute2f128_pd(xy13, z13, 0x20));
+        _mm256_storeu_pd(slot + 8, _mm256_permute2f128_pd(xy02, z02, 0x31));
+        _mm256_storeu_pd(slot + 12, _mm256_permute2f128_pd(xy13, z13, 0x31));
     }
+    double lanes[4];
+    _mm256_storeu_pd(lanes, stiffest4);
+    for (const double t : lanes) stiffest = std::max(stiffest, t);
     return u;
+}
+
+// A pair force is one four-lane load; the lanes add as the scalar sums do.
+[[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+        __m256d sum = _mm256_setzero_pd();
+        for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
+            if (g.alive[b])
+                sum = _mm256_sub_pd(sum, _mm256_loadu_pd(g.pairForce + 4 * g.pairOf[b]));
+        for (int b = g.upperBegin[i], u = g.pairBegin[i]; b < g.offsets[i + 1]; ++b, ++u)
+            if (g.alive[b]) sum = _mm256_add_pd(sum, _mm256_loadu_pd(g.pairForce + 4 * u));
+        double lanes[4];
+        _mm256_storeu_pd(lanes, sum);
+        g.force[3 * i] = lanes[0], g.force[3 * i + 1] = lanes[1], g.force[3 * i + 2] = lanes[2];
+    }
 }
 
 bool hasAvx2() {
@@ -122,22 +247,39 @@ bool hasAvx2() {
 }
 #endif
 
-template <bool kTheta, bool kBreak>
-void pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
+template <bool kPower, bool kTheta, bool kBreak, bool kLook>
+double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
+    double stiffest = 1.0;
 #if defined(__x86_64__)
-    if (hasAvx2()) begin = pairLoopAvx2<kTheta, kBreak>(in, out, begin, end);
+    if (hasAvx2())
+        begin = pairLoopAvx2<kPower, kTheta, kBreak, kLook>(in, out, begin, end, stiffest);
 #endif
-    pairLoop<kTheta, kBreak>(in, out, begin, end);  // the rest
+    return std::max(stiffest, pairLoop<kPower, kTheta, kBreak, kLook>(in, out, begin, end));
+}
+
+template <bool kPower, bool kLook>
+double pairsFor(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
+    const bool theta = in.theta != nullptr, breakable = in.limit != nullptr;
+    if (theta && breakable) return pairs<kPower, true, true, kLook>(in, out, begin, end);
+    if (theta) return pairs<kPower, true, false, kLook>(in, out, begin, end);
+    if (breakable) return pairs<kPower, false, true, kLook>(in, out, begin, end);
+    return pairs<kPower, false, false, kLook>(in, out, begin, end);
 }
 
 }  // namespace
 
-void linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
-    const bool theta = in.theta != nullptr, breakable = in.limit != nullptr;
-    if (theta && breakable) return pairs<true, true>(in, out, begin, end);
-    if (theta) return pairs<true, false>(in, out, begin, end);
-    if (breakable) return pairs<false, true>(in, out, begin, end);
-    pairs<false, false>(in, out, begin, end);
+double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin,
+                        int end) {
+    if (!in.powerLaw) return pairsFor<false, false>(in, out, begin, end);
+    if (in.v) return pairsFor<true, true>(in, out, begin, end);
+    return pairsFor<true, false>(in, out, begin, end);
+}
+
+void gatherPairForces(const PairGather& g, int begin, int end) {
+#if defined(__x86_64__)
+    if (hasAvx2()) return gatherAvx2(g, begin, end);
+#endif
+    gatherLoop(g, begin, end);
 }
 
 }  // namespace rend::sim

@@ -1,9 +1,10 @@
 #pragma once
-// The vectorised first pass of the linear law's force loop (eq. 18 with eqs. 10, 27-28 and the
-// diffusion's strain and weakening): each pair's force on its smaller index, from structure-of-
-// arrays inputs, for a range of pairs. sim/PeridynamicBonds.cpp gathers the pair forces per
-// particle. Four pairs at a time with AVX2 where the CPU has it, else one at a time; both use
-// only +, -, *, / and sqrt (no fused multiply-add), so their bits are the same.
+// The vectorised first pass of the force loop of the linear and power laws (eqs. 18-19 with
+// eqs. 10, 27-28, the diffusion's strain and weakening, and the power law's look-ahead): each
+// pair's force on its smaller index, from structure-of- arrays inputs, for a range of pairs.
+// sim/PeridynamicBonds.cpp gathers the pair forces per particle. Four pairs at a time with AVX2
+// where the CPU has it, else one at a time; both use only +, -, *, / and sqrt (no fused
+// multiply-add), so their bits are the same.
 
 #include <cstdint>
 
@@ -21,16 +22,39 @@ struct LinearPairInput {
     double expansion = 0.0;         ///< alpha
     double stiffnessLoss = 0.0;     ///< of sim/Material.h's degradation()
     double strengthLoss = 0.0;
+    /// The power law (eq. 19) instead of the linear one, with a whole exponent n of 2, 3 or 4:
+    /// BondLaw's own constants. Its look-ahead needs `v`, `alive`, `upper` and `dt`.
+    bool powerLaw = false;
+    double powerC = 0.0, powerCStar = 0.0, powerN = 4.0;
+    const double* v = nullptr;            ///< null: no look-ahead (forces() only)
+    const std::uint8_t* alive = nullptr;  ///< per directed bond
+    const int* upper = nullptr;           ///< per pair: its upper copy
+    double dt = 0.0;
 };
 
 struct LinearPairOutput {
-    double* fx = nullptr;  ///< per pair: its force on i; zero where it is past its limit
-    double* fy = nullptr;
-    double* fz = nullptr;
+    double* force = nullptr;       ///< per pair: x y z 0, its force on i; zero past its limit
     std::uint8_t* over = nullptr;  ///< per pair: past its limit (only with a limit)
 };
 
-/// Pairs [begin, end). Dead bonds are computed too: the gather skips them.
-void linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end);
+/// Pairs [begin, end). Dead bonds are computed too: the gather skips them. Returns the power
+/// law's largest look-ahead tangent over c among the living, unbroken, compressed pairs (at
+/// least 1; 1 without a look-ahead).
+double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end);
+
+/// The second pass: each particle's sum of its living bonds' pair forces in CSR order, minus
+/// where it is the pair's larger index (sim/Bonds.h's BondPairs).
+struct PairGather {
+    const int* offsets = nullptr;
+    const int* upperBegin = nullptr;
+    const int* pairBegin = nullptr;
+    const int* pairOf = nullptr;
+    const std::uint8_t* alive = nullptr;
+    const double* pairForce = nullptr;  ///< LinearPairOutput::force
+    double* force = nullptr;            ///< x y z per particle
+};
+
+/// Particles [begin, end).
+void gatherPairForces(const PairGather& g, int begin, int end);
 
 }  // namespace rend::sim

@@ -32,16 +32,24 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
     slab_ = {0, n, 0, n};
 }
 
+bool PeridynamicBonds::vectorised() const {
+    if (law_.kind == BondLawKind::Linear) return true;
+    const double n = law_.powerN;  // sim/PairKernels.h takes whole exponents 2 to 4
+    return law_.kind == BondLawKind::PowerLaw && !ownLaws() && (n == 2.0 || n == 3.0 || n == 4.0);
+}
+
 void PeridynamicBonds::setUpPairArrays() {
-    if (law_.kind != BondLawKind::Linear) return;
+    if (!vectorised()) return;
     const int pairs = pairs_.pairCount();
     pairFirst_.resize(pairs), pairSecond_.resize(pairs);
     pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
+    pairUpper_.resize(pairs);
     for (int i = 0; i < bonds_.particleCount(); ++i)
         for (int b = pairs_.upperBegin[i]; b < bonds_.offsets[i + 1]; ++b) {
             const int u = pairs_.pairOf[b];
             pairFirst_[u] = i, pairSecond_[u] = bonds_.partners[b];
             pairRest_[u] = bonds_.restLength[b], pairScale_[u] = bondScale_[b];
+            pairUpper_[u] = b;
             pairLimit_[u] = criticalStretch_;
             if (!stretchFactor_.empty()) pairLimit_[u] *= stretchFactor_[b];
         }
@@ -308,63 +316,68 @@ void PeridynamicBonds::linearBondForces(const StepState& s, PairWorkspace& work,
                                         Updates& updates) const {
     const int n = bonds_.particleCount(), pairs = pairs_.pairCount();
     force.resize(n);
-    work.fx.resize(pairs), work.fy.resize(pairs), work.fz.resize(pairs);
+    work.slots.resize(4 * std::size_t(pairs));
     if (kBreak) work.over.resize(pairs);
-    const LinearPairInput in{pairFirst_.data(),
-                             pairSecond_.data(),
-                             pairRest_.data(),
-                             pairScale_.data(),
-                             kBreak ? pairLimit_.data() : nullptr,
-                             s.x.data()->data(),
-                             s.theta.empty() ? nullptr : s.theta.data(),
-                             law_.c,
-                             material_.expansion(),
-                             material_.params().stiffnessLoss,
-                             material_.params().strengthLoss};
-    const LinearPairOutput out{work.fx.data(), work.fy.data(), work.fz.data(), work.over.data()};
-    const int* offsets = bonds_.offsets.data();
-    const int* upperBegin = pairs_.upperBegin.data();
+    LinearPairInput in{pairFirst_.data(),
+                       pairSecond_.data(),
+                       pairRest_.data(),
+                       pairScale_.data(),
+                       kBreak ? pairLimit_.data() : nullptr,
+                       s.x.data()->data(),
+                       s.theta.empty() ? nullptr : s.theta.data(),
+                       law_.c,
+                       material_.expansion(),
+                       material_.params().stiffnessLoss,
+                       material_.params().strengthLoss};
+    in.powerLaw = law_.kind == BondLawKind::PowerLaw;
+    in.powerC = law_.powerC, in.powerCStar = law_.powerCStar, in.powerN = law_.powerN;
+    if (kUpdateBonds && in.powerLaw) {  // the look-ahead
+        in.v = s.v.data()->data(), in.dt = s.dt;
+        in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
+    }
+    const LinearPairOutput out{work.slots.data(), work.over.data()};
+    const PairGather gather{bonds_.offsets.data(),       pairs_.upperBegin.data(),
+                            pairs_.pairBegin.data(),     pairs_.pairOf.data(),
+                            damage_->bondAlive().data(), work.slots.data(),
+                            force.data()->data()};
     const int* pairBegin = pairs_.pairBegin.data();
-    const int* pairOf = pairs_.pairOf.data();
-    const int* twin = pairs_.twin.data();
-    const std::uint8_t* alive = damage_->bondAlive().data();
-    const std::uint8_t* over = work.over.data();
-    std::uint8_t* proposed = updates.proposed;
-    const double *fx = out.fx, *fy = out.fy, *fz = out.fz;
-    int breaking = 0;
-#pragma omp parallel if (n >= kParallelThreshold)
+    double stiffest = 1.0;
+#pragma omp parallel if (n >= kParallelThreshold) reduction(max : stiffest)
     {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
         const std::int64_t first = pairBegin[slab_.ghostBegin],
                            count = pairBegin[slab_.end] - first;
-        linearPairForces(in, out, int(first + count * t / threads),
-                         int(first + count * (t + 1) / threads));
+        stiffest = linearPairForces(in, out, int(first + count * t / threads),
+                                    int(first + count * (t + 1) / threads));
 #pragma omp barrier
-#pragma omp for schedule(static) reduction(+ : breaking)
-        for (int i = slab_.begin; i < slab_.end; ++i) {
-            double sx = 0.0, sy = 0.0, sz = 0.0;
-            for (int b = offsets[i]; b < upperBegin[i]; ++b)
-                if (alive[b]) {
-                    const int u = pairOf[b];
-                    sx -= fx[u], sy -= fy[u], sz -= fz[u];
-                }
-            for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
-                if (alive[b]) {
-                    sx += fx[u], sy += fy[u], sz += fz[u];
-                    if constexpr (kUpdateBonds && kBreak)
-                        if (over[u]) proposed[b] = proposed[twin[u]] = 1, breaking += 2;
-                }
-            force[i] = Eigen::Vector3d(sx, sy, sz);
-        }
+        const int owned = slab_.end - slab_.begin;
+        gatherPairForces(gather, slab_.begin + int(std::int64_t(owned) * t / threads),
+                         slab_.begin + int(std::int64_t(owned) * (t + 1) / threads));
     }
-    updates.breaking = breaking;
+    updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
+    updates.stiffest = stiffest;
+}
+
+// The pairs past their limit among this process's own particles' upper copies: both copies
+// proposed, in pair order.
+int PeridynamicBonds::proposeBreaks(const std::vector<std::uint8_t>& over,
+                                    std::uint8_t* proposed) const {
+    const std::uint8_t* alive = damage_->bondAlive().data();
+    int breaking = 0;
+    for (int u = pairs_.pairBegin[slab_.begin]; u < pairs_.pairBegin[slab_.end]; ++u)
+        if (over[u] && alive[pairs_.twin[u]]) {
+            proposed[pairs_.twin[u]] = 1;
+            proposed[pairUpper_[u]] = 1;
+            breaking += 2;
+        }
+    return breaking;
 }
 
 template <bool kUpdateBonds>
 void PeridynamicBonds::bondForces(const StepState& s, Workspace& work,
                                   std::vector<Eigen::Vector3d>& force, Updates& updates) const {
     PairWorkspace& pairs = static_cast<PairWorkspace&>(work);
-    if (law_.kind == BondLawKind::Linear) {
+    if (vectorised()) {
         if (std::isfinite(criticalStretch_))
             return linearBondForces<kUpdateBonds, true>(s, pairs, force, updates);
         return linearBondForces<kUpdateBonds, false>(s, pairs, force, updates);

@@ -89,14 +89,18 @@ private:
     /// as three arrays, and whether it is past its limit).
     struct PairWorkspace : Workspace {
         std::vector<Eigen::Vector3d> pairForce;
-        std::vector<double> fx, fy, fz;
+        std::vector<double> slots;  ///< the linear law's: x y z 0 per pair
         std::vector<std::uint8_t> over;
     };
-    /// The linear law's loop: sim/PairKernels.h's first pass, then the gather.
+    /// The vectorised laws' loop: sim/PairKernels.h's first pass, then the gather.
     template <bool kUpdateBonds, bool kBreak>
     void linearBondForces(const StepState& s, PairWorkspace& work,
                           std::vector<Eigen::Vector3d>& force, Updates& updates) const;
     void setUpPairArrays();
+    /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, and
+    /// the power law with a whole exponent and no maps of its parameters.
+    bool vectorised() const;
+    int proposeBreaks(const std::vector<std::uint8_t>& over, std::uint8_t* proposed) const;
     double strainEnergyOf(const StepState& s, int begin, int end) const;
     /// The force loop for the scene's law.
     template <bool kUpdateBonds>
@@ -113,7 +117,7 @@ private:
     BondPairs pairs_;  ///< each bond once, for the force loop
     /// Per pair, for the linear law's vectorised pass: its ends, rest length, bond scale and
     /// critical stretch (sim/PairKernels.h).
-    std::vector<int> pairFirst_, pairSecond_;
+    std::vector<int> pairFirst_, pairSecond_, pairUpper_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;

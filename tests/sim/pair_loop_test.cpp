@@ -113,6 +113,53 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     EXPECT_EQ(differ, 0) << "of " << n << " particles";
 }
 
+TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
+    MembraneParams p;
+    p.sheet.size = {0.2, 0.1};
+    p.sheet.dx = 0.01;
+    p.material.youngsModulus = 1e5;
+    p.material.law = BondLawKind::PowerLaw;
+    const Lattice lattice = generateLattice(p.sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx);
+    const std::vector<double> volumes(lattice.positions.size(),
+                                      lattice.particleArea * p.sheet.thickness);
+    PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
+    DamageState damage(bonds, lattice.triangles);
+    solver.bind(bonds, damage);
+    const int n = int(lattice.positions.size());
+    std::vector<Eigen::Vector3d> x = lattice.positions, v(n);
+    for (int i = 0; i < n; ++i)
+        for (int a = 0; a < 3; ++a) {
+            x[i][a] += 0.2 * p.sheet.dx * (2.0 * uniformFromHash(3, 3 * i + a) - 1.0);
+            v[i][a] = 2.0 * uniformFromHash(4, 3 * i + a) - 1.0;
+        }
+    const double dt = 1e-3;
+    // The stiffest bond, broken: the look-ahead must pass over it.
+    double expected = 1.0, stiffest = 1.0;
+    int stiffestBond = -1;
+    for (int pass = 0; pass < 2; ++pass) {
+        expected = 1.0, stiffest = 1.0;
+        for (int i = 0; i < n; ++i)
+            for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+                if (!damage.bondAlive()[b]) continue;
+                const int j = bonds.partners[b];
+                const Eigen::Vector3d r = x[j] - x[i];
+                const double eta = r.norm() / bonds.restLength[b] - 1.0;
+                if (!(eta < 0.0)) continue;
+                const double rate = r.dot(v[j] - v[i]) / (r.norm() * bonds.restLength[b]);
+                const double t = solver.law().powerLawStiffening(
+                    clampCompression(eta + std::min(0.0, dt * rate)));
+                if (t > expected) expected = t, stiffestBond = b;
+            }
+        solver.advanceAt(x, v, dt);
+        stiffest = solver.stiffening();
+        EXPECT_GT(expected, 1.0);
+        EXPECT_EQ(stiffest, expected) << "pass " << pass;
+        ASSERT_GT(stiffestBond, 0);
+        damage.breakBond(stiffestBond);
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                          ::testing::Values(Case{BondLawKind::Linear, false, false},
                                            Case{BondLawKind::Linear, true, true},

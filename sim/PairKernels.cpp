@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/BondLaw.h"
+
 namespace rend::sim {
 namespace {
 
@@ -21,7 +23,7 @@ inline double wholePower(double s, double k) {
 // One loop per stage a scene needs, so each runs without a branch it does not need. The
 // expressions are those of the scalar loop (PeridynamicBonds::bondForcesFor, BondLaw)
 // term by term: the same bits.
-template <bool kPower, bool kTheta, bool kBreak, bool kLook>
+template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     const int* __restrict first = in.first;
     const int* __restrict second = in.second;
@@ -49,8 +51,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             past = eta > limit;
             over[u] = past;
         }
-        if constexpr (kPower) {  // eq. 19, and the tangent where the bond will be in dt
-            if (kLook && eta < 0.0 && !past && in.alive[in.upper[u]]) {
+        if constexpr (kLaw == BondLawKind::PowerLaw) {  // eq. 19, and the tangent in dt
+            if (kUpdate && eta < 0.0 && !past && in.alive[in.upper[u]]) {
                 const double* v = in.v;
                 const double rate =
                     (rx * (v[3 * j] - v[3 * i]) + ry * (v[3 * j + 1] - v[3 * i + 1]) +
@@ -69,6 +71,11 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             const double s = 1.0 + std::max(eta, kMostCompression);
             f = 2.0 * in.powerC * (s - 1.0 / (s * s * s)) +
                 in.powerCStar * in.powerN * (wholePower(s, in.powerN - 1.0) - 1.0);
+        } else if constexpr (kLaw == BondLawKind::Elastoplastic) {  // eq. 20
+            const PlasticState state = in.law->yieldStep(eta, in.plastic[in.upper[u]]);
+            if (kUpdate && !past && in.alive[in.upper[u]])
+                in.plastic[in.upper[u]] = in.plastic[in.twin[u]] = state;
+            f = in.law->forceAs<BondLawKind::Elastoplastic>(eta, state);
         } else {
             f = in.c * eta;  // eq. 18
         }
@@ -121,9 +128,33 @@ struct Lanes {
     return _mm256_mul_pd(_mm256_mul_pd(s, s), s);
 }
 
+// Eq. 20 for four pairs: c eta where no lane has yielded (the common case: no exp), else the
+// yielded lanes through BondLaw itself. The history moves on for the living, unbroken bonds.
+template <bool kUpdate>
+[[gnu::target("avx2")]] __m256d plasticForces(const LinearPairInput& in, int u, __m256d eta,
+                                              __m256d past) {
+    const int* upper = in.upper + u;
+    double strain[4], largest[4], f[4];
+    _mm256_storeu_pd(strain, eta);
+    for (int k = 0; k < 4; ++k)
+        largest[k] = in.law->yieldStep(strain[k], in.plastic[upper[k]]).maxStrain;
+    if constexpr (kUpdate) {
+        const int broken = _mm256_movemask_pd(past);
+        for (int k = 0; k < 4; ++k)
+            if (!((broken >> k) & 1) && in.alive[upper[k]])
+                in.plastic[upper[k]].maxStrain = in.plastic[in.twin[u + k]].maxStrain = largest[k];
+    }
+    const __m256d yielded =
+        _mm256_cmp_pd(_mm256_loadu_pd(largest), _mm256_set1_pd(in.law->yieldStrain), _CMP_GT_OQ);
+    if (_mm256_movemask_pd(yielded) == 0) return _mm256_mul_pd(_mm256_set1_pd(in.c), eta);
+    for (int k = 0; k < 4; ++k)
+        f[k] = in.law->forceAs<BondLawKind::Elastoplastic>(strain[k], PlasticState{largest[k]});
+    return _mm256_loadu_pd(f);
+}
+
 // Four pairs at a time: the same operations in the same order, four lanes wide. The maxima and
 // minima take their arguments in the order that gives std::max and std::min's answer for NaN.
-template <bool kPower, bool kTheta, bool kBreak, bool kLook>
+template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 [[gnu::target("avx2")]] int pairLoopAvx2(const LinearPairInput& in, const LinearPairOutput& out,
                                          int begin, int end, double& stiffest) {
     const __m256d one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
@@ -170,8 +201,8 @@ template <bool kPower, bool kTheta, bool kBreak, bool kLook>
             for (int k = 0; k < 4; ++k) out.over[u + k] = (bits >> k) & 1;
         }
         __m256d f;
-        if constexpr (kPower) {
-            if constexpr (kLook) {
+        if constexpr (kLaw == BondLawKind::PowerLaw) {
+            if constexpr (kUpdate) {
                 const Lanes vi = loadPositions(in.v, in.first + u);
                 const Lanes vj = loadPositions(in.v, in.second + u);
                 const __m256d dot =
@@ -203,6 +234,8 @@ template <bool kPower, bool kTheta, bool kBreak, bool kLook>
                     twoC,
                     _mm256_sub_pd(s, _mm256_div_pd(one, _mm256_mul_pd(_mm256_mul_pd(s, s), s)))),
                 _mm256_mul_pd(starN, _mm256_sub_pd(wholePower4(s, in.powerN - 1.0), one)));
+        } else if constexpr (kLaw == BondLawKind::Elastoplastic) {
+            f = plasticForces<kUpdate>(in, u, eta, past);
         } else {
             f = _mm256_mul_pd(c, eta);
         }
@@ -247,32 +280,40 @@ bool hasAvx2() {
 }
 #endif
 
-template <bool kPower, bool kTheta, bool kBreak, bool kLook>
+template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = 1.0;
 #if defined(__x86_64__)
     if (hasAvx2())
-        begin = pairLoopAvx2<kPower, kTheta, kBreak, kLook>(in, out, begin, end, stiffest);
+        begin = pairLoopAvx2<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
 #endif
-    return std::max(stiffest, pairLoop<kPower, kTheta, kBreak, kLook>(in, out, begin, end));
+    return std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end));
 }
 
-template <bool kPower, bool kLook>
+template <BondLawKind kLaw, bool kUpdate>
 double pairsFor(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     const bool theta = in.theta != nullptr, breakable = in.limit != nullptr;
-    if (theta && breakable) return pairs<kPower, true, true, kLook>(in, out, begin, end);
-    if (theta) return pairs<kPower, true, false, kLook>(in, out, begin, end);
-    if (breakable) return pairs<kPower, false, true, kLook>(in, out, begin, end);
-    return pairs<kPower, false, false, kLook>(in, out, begin, end);
+    if (theta && breakable) return pairs<kLaw, true, true, kUpdate>(in, out, begin, end);
+    if (theta) return pairs<kLaw, true, false, kUpdate>(in, out, begin, end);
+    if (breakable) return pairs<kLaw, false, true, kUpdate>(in, out, begin, end);
+    return pairs<kLaw, false, false, kUpdate>(in, out, begin, end);
 }
 
 }  // namespace
 
 double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin,
                         int end) {
-    if (!in.powerLaw) return pairsFor<false, false>(in, out, begin, end);
-    if (in.v) return pairsFor<true, true>(in, out, begin, end);
-    return pairsFor<true, false>(in, out, begin, end);
+    switch (in.law->kind) {
+        case BondLawKind::Linear:
+            return pairsFor<BondLawKind::Linear, false>(in, out, begin, end);
+        case BondLawKind::PowerLaw:
+            return in.update ? pairsFor<BondLawKind::PowerLaw, true>(in, out, begin, end)
+                             : pairsFor<BondLawKind::PowerLaw, false>(in, out, begin, end);
+        case BondLawKind::Elastoplastic:
+            return in.update ? pairsFor<BondLawKind::Elastoplastic, true>(in, out, begin, end)
+                             : pairsFor<BondLawKind::Elastoplastic, false>(in, out, begin, end);
+    }
+    return 1.0;
 }
 
 void gatherPairForces(const PairGather& g, int begin, int end) {

@@ -8,6 +8,8 @@
 
 #include <cstdint>
 
+#include "sim/BondLaw.h"
+
 namespace rend::sim {
 
 struct LinearPairInput {
@@ -22,14 +24,18 @@ struct LinearPairInput {
     double expansion = 0.0;         ///< alpha
     double stiffnessLoss = 0.0;     ///< of sim/Material.h's degradation()
     double strengthLoss = 0.0;
-    /// The power law (eq. 19) instead of the linear one, with a whole exponent n of 2, 3 or 4:
-    /// BondLaw's own constants. Its look-ahead needs `v`, `alive`, `upper` and `dt`.
-    bool powerLaw = false;
+    /// The law (the power law with a whole exponent n of 2, 3 or 4, no maps of its parameters
+    /// or of the yield strain), with the constants of the power law copied below.
+    const BondLaw* law = nullptr;
     double powerC = 0.0, powerCStar = 0.0, powerN = 4.0;
-    const double* v = nullptr;            ///< null: no look-ahead (forces() only)
+    /// advance(): the power law's look-ahead (needs v, dt), the elastoplastic history's update.
+    bool update = false;
+    const double* v = nullptr;
+    double dt = 0.0;
     const std::uint8_t* alive = nullptr;  ///< per directed bond
     const int* upper = nullptr;           ///< per pair: its upper copy
-    double dt = 0.0;
+    const int* twin = nullptr;            ///< per pair: its lower copy
+    PlasticState* plastic = nullptr;      ///< per directed bond (elastoplastic)
 };
 
 struct LinearPairOutput {

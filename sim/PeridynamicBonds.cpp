@@ -34,6 +34,7 @@ PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& 
 
 bool PeridynamicBonds::vectorised() const {
     if (law_.kind == BondLawKind::Linear) return true;
+    if (law_.kind == BondLawKind::Elastoplastic) return yieldFactor_.empty() && !ownLaws();
     const double n = law_.powerN;  // sim/PairKernels.h takes whole exponents 2 to 4
     return law_.kind == BondLawKind::PowerLaw && !ownLaws() && (n == 2.0 || n == 3.0 || n == 4.0);
 }
@@ -329,12 +330,13 @@ void PeridynamicBonds::linearBondForces(const StepState& s, PairWorkspace& work,
                        material_.expansion(),
                        material_.params().stiffnessLoss,
                        material_.params().strengthLoss};
-    in.powerLaw = law_.kind == BondLawKind::PowerLaw;
+    in.law = &law_;
     in.powerC = law_.powerC, in.powerCStar = law_.powerCStar, in.powerN = law_.powerN;
-    if (kUpdateBonds && in.powerLaw) {  // the look-ahead
-        in.v = s.v.data()->data(), in.dt = s.dt;
-        in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
-    }
+    in.update = kUpdateBonds;
+    in.v = kUpdateBonds ? s.v.data()->data() : nullptr, in.dt = s.dt;
+    in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
+    in.twin = pairs_.twin.data();
+    in.plastic = kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data());
     const LinearPairOutput out{work.slots.data(), work.over.data()};
     const PairGather gather{bonds_.offsets.data(),       pairs_.upperBegin.data(),
                             pairs_.pairBegin.data(),     pairs_.pairOf.data(),

@@ -17,6 +17,7 @@
 #include "app/MpiDomain.h"
 #include "app/Outputs.h"
 #include "app/SceneError.h"
+#include "app/Threads.h"
 #include "render/AtomicFile.h"
 
 namespace rend {
@@ -423,7 +424,10 @@ RunSummary runSlab(const Scene& scene, const RunOptions& options, sim::Membrane&
                    int substeps) {
     RunSummary s;
     int frame = options.resume ? resumeFromCache(scene, options.outDir, last, membrane) : 0;
+    std::optional<ThreadGovernor> governor;
+    if (options.followLoad) governor.emplace(usableCores());
     while (++frame <= last) {
+        if (governor) governor->atFrame();
         membrane.startFrame();
         if (scene.sim.time.adaptive())
             membrane.advanceTo(frame / scene.sim.time.fps);
@@ -546,8 +550,11 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         s.seconds.cache += secondsSince(started);
     };
     std::vector<std::string> frameFiles;  // the current frame's, as they are completed
+    std::optional<ThreadGovernor> governor;
+    if (options.followLoad) governor.emplace(usableCores());
     try {
         for (int frame = resumedAfter + 1; frame <= last; ++frame) {
+            if (governor) governor->atFrame();
             t0 = Clock::now();
             membrane.startFrame();  // a frame's lists are its own: checkpoints resume exactly
             if (adaptive)

@@ -22,6 +22,9 @@ struct RunOptions {
     int cacheEvery = 1;
     /// Continue from the last complete cached frame in outDir (rend run --resume).
     bool resume = false;
+    /// The thread count follows the machine's load frame by frame (app/Threads.h's
+    /// ThreadGovernor): the default, unless --threads or OMP_NUM_THREADS fixes it.
+    bool followLoad = false;
 };
 
 /// Wall seconds per stage of a run.

@@ -1,12 +1,16 @@
 #include "app/Threads.h"
 
+#include <omp.h>
 #include <sched.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -61,6 +65,62 @@ int usableCores() {
     int quota = coresFromCpuMax(firstLine("/sys/fs/cgroup/cpu.max"));
     if (quota == 0) quota = coresFromCfs();
     return quota > 0 ? std::min(cores, quota) : cores;
+}
+
+}  // namespace rend
+
+namespace rend {
+
+double busySecondsFromProcStat(std::string_view procStat, double ticksPerSecond) {
+    if (procStat.substr(0, 4) != "cpu ") return -1.0;
+    const char* p = procStat.data() + 4;
+    const char* end = procStat.data() + procStat.find('\n');
+    double fields[8] = {};  // user nice system idle iowait irq softirq steal
+    for (double& field : fields) {
+        while (p < end && *p == ' ') ++p;
+        long long value = 0;
+        const auto [next, error] = std::from_chars(p, end, value);
+        if (error != std::errc()) return -1.0;
+        field = double(value), p = next;
+    }
+    return (fields[0] + fields[1] + fields[2] + fields[5] + fields[6]) / ticksPerSecond;
+}
+
+int threadsBeside(int usable, double otherCores) {
+    return std::clamp(usable - int(std::lround(std::max(0.0, otherCores))), 1, usable);
+}
+
+namespace {
+
+std::string readSmallFile(const char* path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+double ownCpuSeconds() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+}  // namespace
+
+int ThreadGovernor::atFrame() {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    if (started_ && wall - wall_ < kWindowSeconds) return threads_;
+    const double busy =
+        busySecondsFromProcStat(readSmallFile("/proc/stat"), double(sysconf(_SC_CLK_TCK)));
+    if (busy < 0.0) return threads_;  // no /proc: keep the count
+    const double own = ownCpuSeconds();
+    if (started_) {
+        const double otherCores = ((busy - busy_) - (own - own_)) / (wall - wall_);
+        const int wanted = threadsBeside(usable_, otherCores);
+        if (wanted != threads_) omp_set_num_threads(threads_ = wanted);
+    }
+    started_ = true, wall_ = wall, busy_ = busy, own_ = own;
+    return threads_;
 }
 
 }  // namespace rend

@@ -173,6 +173,7 @@ int runCommand(const RunArgs& a) {
     options.progressBar = isatty(STDERR_FILENO);
     options.cacheEvery = a.cacheEvery;
     options.resume = a.resume;
+    options.followLoad = a.threads <= 0 && std::getenv("OMP_NUM_THREADS") == nullptr;
     const rend::RunSummary s = rend::runScene(scene, options);
     if (rend::processRank() != 0) return 0;  // the first process reports
     std::printf(

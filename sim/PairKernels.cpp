@@ -170,8 +170,6 @@ template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
     __m256d stiffest4 = one;
     int u = begin;
     for (; u + 4 <= end; u += 4) {
-        const __m128i i = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in.first + u));
-        const __m128i j = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in.second + u));
         const Lanes xi = loadPositions(in.x, in.first + u);
         const Lanes xj = loadPositions(in.x, in.second + u);
         const __m256d rx = _mm256_sub_pd(xj.x, xi.x), ry = _mm256_sub_pd(xj.y, xi.y);
@@ -183,8 +181,11 @@ template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
         __m256d eta = _mm256_sub_pd(_mm256_div_pd(length, rest), one);
         __m256d thetaBar = zero, stiffness = one;
         if constexpr (kTheta) {
-            thetaBar = _mm256_mul_pd(half, _mm256_add_pd(_mm256_i32gather_pd(in.theta, i, 8),
-                                                         _mm256_i32gather_pd(in.theta, j, 8)));
+            const int *a = in.first + u, *b = in.second + u;  // loads: AMD's gathers cost more
+            const double* t = in.theta;
+            thetaBar = _mm256_mul_pd(
+                half, _mm256_add_pd(_mm256_set_pd(t[a[3]], t[a[2]], t[a[1]], t[a[0]]),
+                                    _mm256_set_pd(t[b[3]], t[b[2]], t[b[1]], t[b[0]])));
             eta = _mm256_sub_pd(eta, _mm256_mul_pd(expansion, thetaBar));
             stiffness = _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(stiffnessLoss, thetaBar)),
                                       zero);  // max(0, 1 - loss theta)

@@ -183,8 +183,9 @@ void Contact::resolveNodeVelocity(const Eigen::Vector3d& at, Eigen::Vector3d& v,
 }
 
 void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
-                               std::span<const double> mass, std::span<const std::uint8_t> free) {
-    const int n = int(x.size());
+                               std::span<const double> mass, std::span<const std::uint8_t> free,
+                               int first, int last) {
+    const int n = last < 0 ? int(x.size()) - first : last - first;
     // Only the ground's height needs testing where there are no colliders: most particles are
     // well above it and cost one comparison.
     const bool colliders = !poses_.empty();
@@ -197,7 +198,7 @@ void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eige
     std::vector<Eigen::Vector4d> part(std::size_t(blocks), Eigen::Vector4d::Zero());
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int b = 0; b < blocks; ++b)
-        for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+        for (int i = first + b * kBlock; i < first + std::min(n, (b + 1) * kBlock); ++i) {
             if (!free[i] || (!colliders && x[i].z() >= floor)) continue;
             const Eigen::Vector3d before = v[i];
             resolveParticle(x[i], v[i]);

@@ -65,9 +65,11 @@ public:
 
     /// After a drift to the colliders' current pose: moves the particles for which `free` is
     /// set out of the ground and the colliders, with friction on their velocities. Records each
-    /// particle's momentum change (lastImpulse).
+    /// particle's momentum change (lastImpulse). Particles [first, last) only (last -1: all),
+    /// for a decomposed run's slab.
     void resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eigen::Vector3d>& v,
-                          std::span<const double> mass, std::span<const std::uint8_t> free);
+                          std::span<const double> mass, std::span<const std::uint8_t> free,
+                          int first = 0, int last = -1);
 
     /// A grid node's velocity v at `at` against the ground and the colliders (the MPM's grid
     /// collision, sim/Mpm.h): within `reach` of a surface and moving into it, its normal

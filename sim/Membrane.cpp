@@ -175,7 +175,7 @@ void Membrane::kick(double h, double tNext) {
 
 void Membrane::checkFinite() {
     guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
-                  adaptiveStep_, contact_ ? contact_->takeWork() : 0.0, domain_},
+                  adaptiveStep_, colliderWork(), domain_},
                  [this] { return totalEnergy(); });
 }
 
@@ -214,7 +214,7 @@ void Membrane::collide(double tNext) {
     if (!contact_ || !contact_->hasColliders()) return;
     const double t0 = omp_get_wtime();
     contact_->place(tNext);
-    contact_->resolveColliders(x_, v_, mass_, free_);
+    contact_->resolveColliders(x_, v_, mass_, free_, begin_, end_);
     contactSeconds_ += omp_get_wtime() - t0;
 }
 

@@ -198,6 +198,8 @@ private:
     void exchangeMotion();
     /// The whole sheet's kinetic plus strain energy, from the slabs (decomposed runs).
     double totalEnergy() const;
+    /// The colliders' work on the sheet since the last step, over all slabs.
+    double colliderWork();
     /// The fastest particle's speed over all slabs (maxSpeed() where not decomposed).
     double slabMaxSpeed() const;
     /// saveState's and loadState's fields, in order (sim/MembraneState.cpp).

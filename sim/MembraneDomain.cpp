@@ -51,6 +51,11 @@ double Membrane::totalEnergy() const {
     return domain_->sum(kinetic + bonds.slabStrainEnergy(stepState()));
 }
 
+double Membrane::colliderWork() {
+    const double work = contact_ ? contact_->takeWork() : 0.0;
+    return domain_ ? domain_->sum(work) : work;
+}
+
 double Membrane::slabMaxSpeed() const {
     if (!domain_) return maxSpeed();
     double fastest = 0.0;  // squared

@@ -313,7 +313,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
 }
 
 template <bool kUpdateBonds, bool kBreak>
-void PeridynamicBonds::linearBondForces(const StepState& s, PairWorkspace& work,
+void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                                         std::vector<Eigen::Vector3d>& force,
                                         Updates& updates) const {
     const int n = bonds_.particleCount(), pairs = pairs_.pairCount();
@@ -389,8 +389,8 @@ void PeridynamicBonds::bondForces(const StepState& s, Workspace& work,
     PairWorkspace& pairs = static_cast<PairWorkspace&>(work);
     if (vectorised()) {
         if (std::isfinite(criticalStretch_))
-            return linearBondForces<kUpdateBonds, true>(s, pairs, force, updates);
-        return linearBondForces<kUpdateBonds, false>(s, pairs, force, updates);
+            return vectorBondForces<kUpdateBonds, true>(s, pairs, force, updates);
+        return vectorBondForces<kUpdateBonds, false>(s, pairs, force, updates);
     }
     const bool theta = !s.theta.empty();
     const bool breakable = std::isfinite(criticalStretch_);

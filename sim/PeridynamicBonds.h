@@ -94,7 +94,7 @@ private:
     };
     /// The vectorised laws' loop: sim/PairKernels.h's first pass, then the gather.
     template <bool kUpdateBonds, bool kBreak>
-    void linearBondForces(const StepState& s, PairWorkspace& work,
+    void vectorBondForces(const StepState& s, PairWorkspace& work,
                           std::vector<Eigen::Vector3d>& force, Updates& updates) const;
     void setUpPairArrays();
     /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, and

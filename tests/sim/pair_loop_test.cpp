@@ -15,12 +15,16 @@ using namespace rend::sim;
 
 namespace {
 
-TEST(BondPairs, NumberEachBondOnceThroughItsUpperCopy) {
+/// The bonds of a hexagonal sheet of `width` x `height` at dx = 0.01 within `horizon` dx.
+BondFamilies sheetBonds(double width, double height, double horizon) {
     SheetParams sheet;
-    sheet.size = {0.2, 0.1};
+    sheet.size = {width, height};
     sheet.dx = 0.01;
-    const Lattice lattice = generateLattice(sheet);
-    const BondFamilies bonds = buildBondFamilies(lattice.positions, 2.5 * sheet.dx);
+    return buildBondFamilies(generateLattice(sheet).positions, horizon * sheet.dx);
+}
+
+TEST(BondPairs, NumberEachBondOnceThroughItsUpperCopy) {
+    const BondFamilies bonds = sheetBonds(0.2, 0.1, 2.5);
     const BondPairs pairs = buildBondPairs(bonds);
     ASSERT_EQ(std::size_t(pairs.pairCount()), bonds.bondCount());
     std::vector<int> seen(pairs.pairCount(), 0);
@@ -170,16 +174,8 @@ INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                                            Case{BondLawKind::Elastoplastic, false, true},
                                            Case{BondLawKind::Elastoplastic, true, true}));
 
-}  // namespace
-
-namespace {
-
 TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
-    SheetParams sheet;
-    sheet.size = {0.3, 0.2};
-    sheet.dx = 0.01;
-    const Lattice lattice = generateLattice(sheet);
-    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * sheet.dx);
+    const BondFamilies bonds = sheetBonds(0.3, 0.2, 1.5);
     const int n = bonds.particleCount();
     for (const int count : {1, 2, 3, 7}) {
         const std::vector<Slab> slabs = partitionSlabs(bonds, count);

@@ -93,28 +93,35 @@ BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
 
 // One block's sums. Only v is checked for finiteness: x moves by dt v from a finite start, so a
 // non-finite x has had a non-finite v first (or one over the limit), and skipping it halves the
-// memory the pass reads.
+// memory the pass reads. The sums live in locals, not in `out`: a store to a double the compiler
+// cannot prove apart from the spans would put a store and a reload on every particle's chain.
 void BlowUpGuard::sampleBlock(const State& s, int begin, int end, Sample& out) const {
     const double limitSquared = speedLimit_ * speedLimit_;
+    const Eigen::Vector3d gravity = gravity_;
+    const bool hasGravity = hasGravity_;
+    double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0, maxSpeedSquared = 0.0;
+    int fastest = -1, firstBad = -1;
     for (int i = begin; i < end; ++i) {
         const double speedSquared = s.v[i].squaredNorm();
-        if (!(speedSquared <= limitSquared) && out.firstBad < 0) out.firstBad = i;
-        if (s.constraint[i] != kFree) {
-            if (s.constraint[i] >= 0) out.boundaryPower += std::abs(s.force[i].dot(s.v[i]));
+        if (!(speedSquared <= limitSquared) && firstBad < 0) firstBad = i;
+        const std::int16_t c = s.constraint[i];
+        if (c != kFree) {
+            if (c >= 0) boundaryPower += std::abs(s.force[i].dot(s.v[i]));
             continue;
         }
-        out.kinetic += 0.5 * s.mass[i] * speedSquared;
-        if (hasGravity_) out.gravityPower += s.mass[i] * std::abs(gravity_.dot(s.v[i]));
-        if (speedSquared > out.maxSpeedSquared) {
-            out.maxSpeedSquared = speedSquared;
-            out.fastest = i;
+        kinetic += 0.5 * s.mass[i] * speedSquared;
+        if (hasGravity) gravityPower += s.mass[i] * std::abs(gravity.dot(s.v[i]));
+        if (speedSquared > maxSpeedSquared) {
+            maxSpeedSquared = speedSquared;
+            fastest = i;
         }
     }
-    if (s.theta.empty()) return;
-    for (int i = begin; i < end; ++i) {
-        if (!std::isfinite(s.theta[i]) && (out.firstBad < 0 || i < out.firstBad)) out.firstBad = i;
-        out.maxAbsTheta = std::max(out.maxAbsTheta, std::abs(s.theta[i]));
+    double maxAbsTheta = 0.0;
+    for (int i = begin; i < int(s.theta.size()) && i < end; ++i) {
+        if (!std::isfinite(s.theta[i]) && (firstBad < 0 || i < firstBad)) firstBad = i;
+        maxAbsTheta = std::max(maxAbsTheta, std::abs(s.theta[i]));
     }
+    out = {kinetic, boundaryPower, gravityPower, maxSpeedSquared, maxAbsTheta, fastest, firstBad};
 }
 
 BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {

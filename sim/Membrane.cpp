@@ -11,6 +11,7 @@
 #include "sim/Fracture.h"
 #include "sim/Material.h"
 #include "sim/SolverRegistry.h"
+#include "sim/StepKernels.h"
 
 namespace rend::sim {
 
@@ -200,14 +201,35 @@ void Membrane::integrate(double dt, double tNext) {
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
         for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
     } else {
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-        for (int i = begin_; i < end_; ++i) {
-            updateVelocity(i, kickDt, tNext, gravity, damping);
-            x_[i] += dt * v_[i];
-        }
+        kickAndDrift(kickDt, dt, tNext);
     }
     collide(tNext);
     if (domain_) exchangeMotion();
+}
+
+// updateVelocity and the drift in one pass (sim/StepKernels.h: the same bits), by blocks.
+void Membrane::kickAndDrift(double h, double dt, double tNext) {
+    std::vector<double> prescribed(3 * params_.boundaries.size());
+    for (std::size_t b = 0; b < params_.boundaries.size(); ++b) {
+        const Eigen::Vector3d velocity = boundaryVelocity(int(b), tNext);
+        for (int a = 0; a < 3; ++a) prescribed[3 * b + a] = velocity[a];
+    }
+    KickDrift k{x_.data()->data(),
+                v_.data()->data(),
+                force_.data()->data(),
+                mass_.data(),
+                constraint_.data(),
+                prescribed,
+                h,
+                dt,
+                {},
+                params_.damping};
+    for (int a = 0; a < 3; ++a) k.gravity[a] = params_.gravity[a];
+    constexpr int kBlock = 1024;
+    const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold)
+    for (int b = 0; b < blocks; ++b)
+        kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock));
 }
 
 void Membrane::collide(double tNext) {

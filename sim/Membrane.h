@@ -188,6 +188,8 @@ private:
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
     void integrate(double h, double tNext);
+    /// integrate's kick of h and drift of dt over this process's particles (not the MPM's).
+    void kickAndDrift(double h, double dt, double tNext);
     /// Contact after a drift to tNext: the colliders placed there push the free particles out.
     void collide(double tNext);
     void setUpContact(const MembraneParams& params);

@@ -129,24 +129,35 @@ struct Lanes {
 }
 
 // Eq. 20 for four pairs: c eta where no lane has yielded (the common case: no exp), else the
-// yielded lanes through BondLaw itself. The history moves on for the living, unbroken bonds.
+// yielded lanes through BondLaw itself. The largest strain is BondLaw::yieldStep's std::max
+// (max_pd(eta, m) answers as it does for NaN); the history moves on for the living, unbroken
+// bonds, and is written only where it grew (both copies always hold the same value).
 template <bool kUpdate>
 [[gnu::target("avx2")]] __m256d plasticForces(const LinearPairInput& in, int u, __m256d eta,
                                               __m256d past) {
     const int* upper = in.upper + u;
-    double strain[4], largest[4], f[4];
-    _mm256_storeu_pd(strain, eta);
-    for (int k = 0; k < 4; ++k)
-        largest[k] = in.law->yieldStep(strain[k], in.plastic[upper[k]]).maxStrain;
+    const PlasticState* plastic = in.plastic;
+    const __m256d held = _mm256_setr_pd(plastic[upper[0]].maxStrain, plastic[upper[1]].maxStrain,
+                                        plastic[upper[2]].maxStrain, plastic[upper[3]].maxStrain);
+    const __m256d largest4 = _mm256_max_pd(eta, held);
     if constexpr (kUpdate) {
-        const int broken = _mm256_movemask_pd(past);
-        for (int k = 0; k < 4; ++k)
-            if (!((broken >> k) & 1) && in.alive[upper[k]])
-                in.plastic[upper[k]].maxStrain = in.plastic[in.twin[u + k]].maxStrain = largest[k];
+        const int grew = _mm256_movemask_pd(_mm256_cmp_pd(largest4, held, _CMP_NEQ_UQ)) &
+                         ~_mm256_movemask_pd(past);
+        if (grew) {
+            double largest[4];
+            _mm256_storeu_pd(largest, largest4);
+            for (int k = 0; k < 4; ++k)
+                if (((grew >> k) & 1) && in.alive[upper[k]])
+                    in.plastic[upper[k]].maxStrain = in.plastic[in.twin[u + k]].maxStrain =
+                        largest[k];
+        }
     }
     const __m256d yielded =
-        _mm256_cmp_pd(_mm256_loadu_pd(largest), _mm256_set1_pd(in.law->yieldStrain), _CMP_GT_OQ);
+        _mm256_cmp_pd(largest4, _mm256_set1_pd(in.law->yieldStrain), _CMP_GT_OQ);
     if (_mm256_movemask_pd(yielded) == 0) return _mm256_mul_pd(_mm256_set1_pd(in.c), eta);
+    double strain[4], largest[4], f[4];
+    _mm256_storeu_pd(strain, eta);
+    _mm256_storeu_pd(largest, largest4);
     for (int k = 0; k < 4; ++k)
         f[k] = in.law->forceAs<BondLawKind::Elastoplastic>(strain[k], PlasticState{largest[k]});
     return _mm256_loadu_pd(f);
@@ -262,16 +273,22 @@ template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 
 // A pair force is one four-lane load; the lanes add as the scalar sums do.
 [[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
+    const int* __restrict offsets = g.offsets;
+    const int* __restrict upperBegin = g.upperBegin;
+    const int* __restrict pairBegin = g.pairBegin;
+    const int* __restrict pairOf = g.pairOf;
+    const std::uint8_t* __restrict alive = g.alive;
+    const double* __restrict pairForce = g.pairForce;
+    double* __restrict force = g.force;
     for (int i = begin; i < end; ++i) {
         __m256d sum = _mm256_setzero_pd();
-        for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
-            if (g.alive[b])
-                sum = _mm256_sub_pd(sum, _mm256_loadu_pd(g.pairForce + 4 * g.pairOf[b]));
-        for (int b = g.upperBegin[i], u = g.pairBegin[i]; b < g.offsets[i + 1]; ++b, ++u)
-            if (g.alive[b]) sum = _mm256_add_pd(sum, _mm256_loadu_pd(g.pairForce + 4 * u));
+        for (int b = offsets[i]; b < upperBegin[i]; ++b)
+            if (alive[b]) sum = _mm256_sub_pd(sum, _mm256_loadu_pd(pairForce + 4 * pairOf[b]));
+        for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
+            if (alive[b]) sum = _mm256_add_pd(sum, _mm256_loadu_pd(pairForce + 4 * u));
         double lanes[4];
         _mm256_storeu_pd(lanes, sum);
-        g.force[3 * i] = lanes[0], g.force[3 * i + 1] = lanes[1], g.force[3 * i + 2] = lanes[2];
+        force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];
     }
 }
 

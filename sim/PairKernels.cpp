@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <string_view>
 
 #include "sim/BondLaw.h"
 
@@ -104,172 +106,127 @@ void gatherLoop(const PairGather& g, int begin, int end) {
 }
 
 #if defined(__x86_64__)
-// The x, y and z of four particles as three four-lane vectors, from plain loads: AMD's gathers
-// cost more than the loads and shuffles.
-struct Lanes {
-    __m256d x, y, z;
-};
-[[gnu::target("avx2"), gnu::always_inline]] inline Lanes loadPositions(const double* p,
-                                                                       const int* index) {
-    const double* a = p + 3 * index[0];
-    const double* b = p + 3 * index[1];
-    const double* c = p + 3 * index[2];
-    const double* d = p + 3 * index[3];
-    const __m256d ac = _mm256_set_m128d(_mm_loadu_pd(c), _mm_loadu_pd(a));
-    const __m256d bd = _mm256_set_m128d(_mm_loadu_pd(d), _mm_loadu_pd(b));
-    return {_mm256_unpacklo_pd(ac, bd), _mm256_unpackhi_pd(ac, bd),
-            _mm256_set_pd(d[2], c[2], b[2], a[2])};
-}
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace avx2 {
 
-[[gnu::target("avx2"), gnu::always_inline]] inline __m256d wholePower4(__m256d s, double k) {
-    if (k == 0.0) return _mm256_set1_pd(1.0);
-    if (k == 1.0) return s;
-    if (k == 2.0) return _mm256_mul_pd(s, s);
-    return _mm256_mul_pd(_mm256_mul_pd(s, s), s);
-}
+using V = __m256d;
+using M = __m256d;
+constexpr int kLanes = 4;
 
-// Eq. 20 for four pairs: c eta where no lane has yielded (the common case: no exp), else the
-// yielded lanes through BondLaw itself. The largest strain is BondLaw::yieldStep's std::max
-// (max_pd(eta, m) answers as it does for NaN); the history moves on for the living, unbroken
-// bonds, and is written only where it grew (both copies always hold the same value).
-template <bool kUpdate>
-[[gnu::target("avx2")]] __m256d plasticForces(const LinearPairInput& in, int u, __m256d eta,
-                                              __m256d past) {
-    const int* upper = in.upper + u;
-    const PlasticState* plastic = in.plastic;
-    const __m256d held = _mm256_setr_pd(plastic[upper[0]].maxStrain, plastic[upper[1]].maxStrain,
-                                        plastic[upper[2]].maxStrain, plastic[upper[3]].maxStrain);
-    const __m256d largest4 = _mm256_max_pd(eta, held);
-    if constexpr (kUpdate) {
-        const int grew = _mm256_movemask_pd(_mm256_cmp_pd(largest4, held, _CMP_NEQ_UQ)) &
-                         ~_mm256_movemask_pd(past);
-        if (grew) {
-            double largest[4];
-            _mm256_storeu_pd(largest, largest4);
-            for (int k = 0; k < 4; ++k)
-                if (((grew >> k) & 1) && in.alive[upper[k]])
-                    in.plastic[upper[k]].maxStrain = in.plastic[in.twin[u + k]].maxStrain =
-                        largest[k];
-        }
+// Four lanes; a mask is all ones or all zeros per lane.
+struct Simd {
+    static V set1(double a) { return _mm256_set1_pd(a); }
+    static V zero() { return _mm256_setzero_pd(); }
+    static V load(const double* p) { return _mm256_loadu_pd(p); }
+    static void store(double* p, V a) { _mm256_storeu_pd(p, a); }
+    static V add(V a, V b) { return _mm256_add_pd(a, b); }
+    static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
+    static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
+    static V div(V a, V b) { return _mm256_div_pd(a, b); }
+    static V sqrt(V a) { return _mm256_sqrt_pd(a); }
+    static V max(V a, V b) { return _mm256_max_pd(a, b); }
+    static V min(V a, V b) { return _mm256_min_pd(a, b); }
+    static M gt(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+    static M lt(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+    static M neqOrdered(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_OQ); }
+    static M neqUnordered(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
+    static M noLanes() { return _mm256_setzero_pd(); }
+    static M andNot(M a, M b) { return _mm256_andnot_pd(a, b); }  ///< not a, and b
+    static M both(M a, M b) { return _mm256_and_pd(a, b); }
+    static V blend(V a, V b, M m) { return _mm256_blendv_pd(a, b, m); }  ///< m ? b : a
+    static unsigned bits(M m) { return unsigned(_mm256_movemask_pd(m)); }
+    template <class Read>
+    [[gnu::always_inline]] static V lanes(Read read) {
+        return _mm256_setr_pd(read(0), read(1), read(2), read(3));
     }
-    const __m256d yielded =
-        _mm256_cmp_pd(largest4, _mm256_set1_pd(in.law->yieldStrain), _CMP_GT_OQ);
-    if (_mm256_movemask_pd(yielded) == 0) return _mm256_mul_pd(_mm256_set1_pd(in.c), eta);
-    double strain[4], largest[4], f[4];
-    _mm256_storeu_pd(strain, eta);
-    _mm256_storeu_pd(largest, largest4);
-    for (int k = 0; k < 4; ++k)
-        f[k] = in.law->forceAs<BondLawKind::Elastoplastic>(strain[k], PlasticState{largest[k]});
-    return _mm256_loadu_pd(f);
-}
-
-// Four pairs at a time: the same operations in the same order, four lanes wide. The maxima and
-// minima take their arguments in the order that gives std::max and std::min's answer for NaN.
-template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
-[[gnu::target("avx2")]] int pairLoopAvx2(const LinearPairInput& in, const LinearPairOutput& out,
-                                         int begin, int end, double& stiffest) {
-    const __m256d one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
-    const __m256d half = _mm256_set1_pd(0.5), c = _mm256_set1_pd(in.c);
-    const __m256d expansion = _mm256_set1_pd(in.expansion);
-    const __m256d stiffnessLoss = _mm256_set1_pd(in.stiffnessLoss);
-    const __m256d strengthLoss = _mm256_set1_pd(in.strengthLoss);
-    const __m256d most = _mm256_set1_pd(kMostCompression), dt = _mm256_set1_pd(in.dt);
-    const __m256d twoC = _mm256_set1_pd(2.0 * in.powerC);
-    const __m256d starN = _mm256_set1_pd(in.powerCStar * in.powerN);
-    const __m256d starNN = _mm256_set1_pd(in.powerCStar * in.powerN * (in.powerN - 1.0));
-    const __m256d three = _mm256_set1_pd(3.0);
-    __m256d stiffest4 = one;
-    int u = begin;
-    for (; u + 4 <= end; u += 4) {
-        const Lanes xi = loadPositions(in.x, in.first + u);
-        const Lanes xj = loadPositions(in.x, in.second + u);
-        const __m256d rx = _mm256_sub_pd(xj.x, xi.x), ry = _mm256_sub_pd(xj.y, xi.y);
-        const __m256d rz = _mm256_sub_pd(xj.z, xi.z);
-        const __m256d squared = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(rx, rx), _mm256_mul_pd(ry, ry)), _mm256_mul_pd(rz, rz));
-        const __m256d length = _mm256_sqrt_pd(squared);
-        const __m256d rest = _mm256_loadu_pd(in.restLength + u);
-        __m256d eta = _mm256_sub_pd(_mm256_div_pd(length, rest), one);
-        __m256d thetaBar = zero, stiffness = one;
-        if constexpr (kTheta) {
-            const int *a = in.first + u, *b = in.second + u;  // loads: AMD's gathers cost more
-            const double* t = in.theta;
-            thetaBar = _mm256_mul_pd(
-                half, _mm256_add_pd(_mm256_set_pd(t[a[3]], t[a[2]], t[a[1]], t[a[0]]),
-                                    _mm256_set_pd(t[b[3]], t[b[2]], t[b[1]], t[b[0]])));
-            eta = _mm256_sub_pd(eta, _mm256_mul_pd(expansion, thetaBar));
-            stiffness = _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(stiffnessLoss, thetaBar)),
-                                      zero);  // max(0, 1 - loss theta)
-        }
-        __m256d past = zero;
-        if constexpr (kBreak) {
-            __m256d limit = _mm256_loadu_pd(in.limit + u);
-            if constexpr (kTheta)
-                limit = _mm256_mul_pd(
-                    limit,
-                    _mm256_max_pd(_mm256_sub_pd(one, _mm256_mul_pd(strengthLoss, thetaBar)), zero));
-            past = _mm256_cmp_pd(eta, limit, _CMP_GT_OQ);
-            const int bits = _mm256_movemask_pd(past);
-            for (int k = 0; k < 4; ++k) out.over[u + k] = (bits >> k) & 1;
-        }
-        __m256d f;
-        if constexpr (kLaw == BondLawKind::PowerLaw) {
-            if constexpr (kUpdate) {
-                const Lanes vi = loadPositions(in.v, in.first + u);
-                const Lanes vj = loadPositions(in.v, in.second + u);
-                const __m256d dot =
-                    _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx, _mm256_sub_pd(vj.x, vi.x)),
-                                                _mm256_mul_pd(ry, _mm256_sub_pd(vj.y, vi.y))),
-                                  _mm256_mul_pd(rz, _mm256_sub_pd(vj.z, vi.z)));
-                const __m256d rate = _mm256_div_pd(dot, _mm256_mul_pd(length, rest));
-                const __m256d ahead = _mm256_max_pd(
-                    most, _mm256_add_pd(eta, _mm256_min_pd(_mm256_mul_pd(dt, rate), zero)));
-                const __m256d s = _mm256_add_pd(one, ahead), s2 = _mm256_mul_pd(s, s);
-                __m256d tangent = _mm256_div_pd(
-                    _mm256_add_pd(
-                        _mm256_mul_pd(
-                            twoC, _mm256_add_pd(one, _mm256_div_pd(three, _mm256_mul_pd(s2, s2)))),
-                        _mm256_mul_pd(starNN, wholePower4(s, in.powerN - 2.0))),
-                    c);
-                if constexpr (kTheta) tangent = _mm256_mul_pd(tangent, stiffness);
-                const int* upper = in.upper + u;
-                const __m256d alive = _mm256_set_pd(in.alive[upper[3]], in.alive[upper[2]],
-                                                    in.alive[upper[1]], in.alive[upper[0]]);
-                const __m256d counts =
-                    _mm256_and_pd(_mm256_andnot_pd(past, _mm256_cmp_pd(eta, zero, _CMP_LT_OQ)),
-                                  _mm256_cmp_pd(alive, zero, _CMP_NEQ_OQ));
-                stiffest4 = _mm256_max_pd(_mm256_blendv_pd(one, tangent, counts), stiffest4);
-            }
-            const __m256d s = _mm256_add_pd(one, _mm256_max_pd(most, eta));
-            f = _mm256_add_pd(
-                _mm256_mul_pd(
-                    twoC,
-                    _mm256_sub_pd(s, _mm256_div_pd(one, _mm256_mul_pd(_mm256_mul_pd(s, s), s)))),
-                _mm256_mul_pd(starN, _mm256_sub_pd(wholePower4(s, in.powerN - 1.0), one)));
-        } else if constexpr (kLaw == BondLawKind::Elastoplastic) {
-            f = plasticForces<kUpdate>(in, u, eta, past);
-        } else {
-            f = _mm256_mul_pd(c, eta);
-        }
-        if constexpr (kTheta) f = _mm256_mul_pd(f, stiffness);
-        __m256d coef = _mm256_div_pd(_mm256_mul_pd(_mm256_loadu_pd(in.scale + u), f), length);
-        if constexpr (kBreak) coef = _mm256_blendv_pd(coef, zero, past);
-        // Four x y z 0 slots from the three lanes of x, of y and of z.
-        const __m256d fx = _mm256_mul_pd(coef, rx), fy = _mm256_mul_pd(coef, ry);
-        const __m256d fz = _mm256_mul_pd(coef, rz);
-        const __m256d xy02 = _mm256_unpacklo_pd(fx, fy), xy13 = _mm256_unpackhi_pd(fx, fy);
-        const __m256d z02 = _mm256_unpacklo_pd(fz, zero), z13 = _mm256_unpackhi_pd(fz, zero);
-        double* slot = out.force + 4 * std::size_t(u);
+    /// The x, y and z of four particles from plain loads: AMD's gathers cost more.
+    [[gnu::always_inline]] static void loadPositions(const double* p, const int* index, V& x, V& y,
+                                                     V& z) {
+        const double* a = p + 3 * index[0];
+        const double* b = p + 3 * index[1];
+        const double* c = p + 3 * index[2];
+        const double* d = p + 3 * index[3];
+        const V ac = _mm256_set_m128d(_mm_loadu_pd(c), _mm_loadu_pd(a));
+        const V bd = _mm256_set_m128d(_mm_loadu_pd(d), _mm_loadu_pd(b));
+        x = _mm256_unpacklo_pd(ac, bd), y = _mm256_unpackhi_pd(ac, bd);
+        z = _mm256_setr_pd(a[2], b[2], c[2], d[2]);
+    }
+    /// Four x y z 0 slots from the lanes of x, of y and of z.
+    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz) {
+        const V zero = _mm256_setzero_pd();
+        const V xy02 = _mm256_unpacklo_pd(fx, fy), xy13 = _mm256_unpackhi_pd(fx, fy);
+        const V z02 = _mm256_unpacklo_pd(fz, zero), z13 = _mm256_unpackhi_pd(fz, zero);
         _mm256_storeu_pd(slot, _mm256_permute2f128_pd(xy02, z02, 0x20));
         _mm256_storeu_pd(slot + 4, _mm256_permute2f128_pd(xy13, z13, 0x20));
         _mm256_storeu_pd(slot + 8, _mm256_permute2f128_pd(xy02, z02, 0x31));
         _mm256_storeu_pd(slot + 12, _mm256_permute2f128_pd(xy13, z13, 0x31));
     }
-    double lanes[4];
-    _mm256_storeu_pd(lanes, stiffest4);
-    for (const double t : lanes) stiffest = std::max(stiffest, t);
-    return u;
-}
+};
+
+#include "sim/PairKernelSimd.inc"
+
+}  // namespace avx2
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx2,avx512f")
+namespace avx512 {
+
+using V = __m512d;
+using M = __mmask8;
+constexpr int kLanes = 8;
+
+// Eight lanes: on CPUs whose dividers are 512 bits wide (AMD Zen 5), twice the ÷ and √ of AVX2
+// per instruction. Masks are bits.
+struct Simd {
+    static V set1(double a) { return _mm512_set1_pd(a); }
+    static V zero() { return _mm512_setzero_pd(); }
+    static V load(const double* p) { return _mm512_loadu_pd(p); }
+    static void store(double* p, V a) { _mm512_storeu_pd(p, a); }
+    static V add(V a, V b) { return _mm512_add_pd(a, b); }
+    static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
+    static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+    static V div(V a, V b) { return _mm512_div_pd(a, b); }
+    static V sqrt(V a) { return _mm512_sqrt_pd(a); }
+    static V max(V a, V b) { return _mm512_max_pd(a, b); }
+    static V min(V a, V b) { return _mm512_min_pd(a, b); }
+    static M gt(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+    static M lt(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+    static M neqOrdered(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_OQ); }
+    static M neqUnordered(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
+    static M noLanes() { return 0; }
+    static M andNot(M a, M b) { return M(~a & b); }
+    static M both(M a, M b) { return M(a & b); }
+    static V blend(V a, V b, M m) { return _mm512_mask_blend_pd(m, a, b); }
+    static unsigned bits(M m) { return m; }
+    template <class Read>
+    [[gnu::always_inline]] static V lanes(Read read) {
+        return _mm512_setr_pd(read(0), read(1), read(2), read(3), read(4), read(5), read(6),
+                              read(7));
+    }
+    [[gnu::always_inline]] static V join(__m256d low, __m256d high) {
+        return _mm512_insertf64x4(_mm512_castpd256_pd512(low), high, 1);
+    }
+    [[gnu::always_inline]] static void loadPositions(const double* p, const int* index, V& x, V& y,
+                                                     V& z) {
+        __m256d x0, y0, z0, x1, y1, z1;
+        avx2::Simd::loadPositions(p, index, x0, y0, z0);
+        avx2::Simd::loadPositions(p, index + 4, x1, y1, z1);
+        x = join(x0, x1), y = join(y0, y1), z = join(z0, z1);
+    }
+    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz) {
+        avx2::Simd::storeSlots(slot, _mm512_castpd512_pd256(fx), _mm512_castpd512_pd256(fy),
+                               _mm512_castpd512_pd256(fz));
+        avx2::Simd::storeSlots(slot + 16, _mm512_extractf64x4_pd(fx, 1),
+                               _mm512_extractf64x4_pd(fy, 1), _mm512_extractf64x4_pd(fz, 1));
+    }
+};
+
+#include "sim/PairKernelSimd.inc"
+
+}  // namespace avx512
+#pragma GCC pop_options
 
 // A pair force is one four-lane load; the lanes add as the scalar sums do.
 [[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
@@ -296,14 +253,24 @@ bool hasAvx2() {
     static const bool has = __builtin_cpu_supports("avx2");
     return has;
 }
+
+/// REND_SIMD=avx2 keeps a CPU with AVX-512 on the four-lane kernel (for comparing them).
+bool hasAvx512() {
+    static const bool has =
+        __builtin_cpu_supports("avx512f") &&
+        std::string_view(std::getenv("REND_SIMD") ? std::getenv("REND_SIMD") : "") != "avx2";
+    return has;
+}
 #endif
 
 template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = 1.0;
 #if defined(__x86_64__)
-    if (hasAvx2())
-        begin = pairLoopAvx2<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
+    if (hasAvx512())
+        begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
+    else if (hasAvx2())
+        begin = avx2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
 #endif
     return std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end));
 }

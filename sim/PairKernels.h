@@ -1,10 +1,12 @@
 #pragma once
-// The vectorised first pass of the force loop of the linear and power laws (eqs. 18-19 with
-// eqs. 10, 27-28, the diffusion's strain and weakening, and the power law's look-ahead): each
-// pair's force on its smaller index, from structure-of- arrays inputs, for a range of pairs.
-// sim/PeridynamicBonds.cpp gathers the pair forces per particle. Four pairs at a time with AVX2
-// where the CPU has it, else one at a time; both use only +, -, *, / and sqrt (no fused
-// multiply-add), so their bits are the same.
+// The vectorised first pass of the force loop of every bond law (eqs. 18-20 with eqs. 10,
+// 27-28, the diffusion's strain and weakening, the power law's look-ahead and the elastoplastic
+// history): each pair's force on its smaller index, from structure-of-arrays inputs, for a range
+// of pairs. sim/PeridynamicBonds.cpp gathers the pair forces per particle. Eight pairs at a time
+// with AVX-512 where the CPU has it, else four with AVX2, else one at a time
+// (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt (no
+// fused multiply-add), so their bits are the same. REND_SIMD=avx2 in the environment keeps a CPU on
+// four lanes.
 
 #include <cstdint>
 

@@ -164,6 +164,49 @@ TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
     }
 }
 
+// advance() moves the elastoplastic history on in the kernel: both copies of every living,
+// unbroken bond hold the largest strain it has seen, and a dead bond's history stays put.
+TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {
+    MembraneParams p;
+    p.sheet.size = {0.2, 0.1};
+    p.sheet.dx = 0.01;
+    p.material.youngsModulus = 1e5;
+    p.material.law = BondLawKind::Elastoplastic;
+    p.material.yieldStrain = 0.002;
+    const Lattice lattice = generateLattice(p.sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx);
+    const std::vector<double> volumes(lattice.positions.size(),
+                                      lattice.particleArea * p.sheet.thickness);
+    PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
+    DamageState damage(bonds, lattice.triangles);
+    solver.bind(bonds, damage);
+    for (int b = 0; b < int(bonds.directedCount()); b += 29) damage.breakBond(b);
+    const int n = int(lattice.positions.size());
+    std::vector<double> largest(bonds.directedCount(), 0.0);
+    std::vector<Eigen::Vector3d> v(n, Eigen::Vector3d::Zero());
+    for (const double amplitude : {0.004, 0.001, 0.006}) {  // strains of up to ~2 amplitudes
+        std::vector<Eigen::Vector3d> x = lattice.positions;
+        for (int i = 0; i < n; ++i)
+            for (int a = 0; a < 2; ++a)
+                x[i][a] += amplitude * p.sheet.dx * (2.0 * uniformFromHash(11, 3 * i + a) - 1.0);
+        for (int i = 0; i < n; ++i)
+            for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
+                if (damage.bondAlive()[b]) {
+                    const double eta =
+                        (x[bonds.partners[b]] - x[i]).norm() / bonds.restLength[b] - 1.0;
+                    largest[b] = std::max(largest[b], eta);
+                }
+        solver.advanceAt(x, v, 1e-5);
+        int differ = 0, grew = 0;
+        for (std::size_t b = 0; b < largest.size(); ++b) {
+            differ += solver.plasticState()[b].maxStrain != largest[b];
+            grew += largest[b] > p.material.yieldStrain;
+        }
+        EXPECT_EQ(differ, 0) << "amplitude " << amplitude;
+        EXPECT_GT(grew, 100) << "the test yields bonds";
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                          ::testing::Values(Case{BondLawKind::Linear, false, false},
                                            Case{BondLawKind::Linear, true, true},

@@ -40,8 +40,25 @@ bool PeridynamicBonds::vectorised() const {
     return law_.kind == BondLawKind::PowerLaw && !ownLaws() && (n == 2.0 || n == 3.0 || n == 4.0);
 }
 
+// The first particle from which on, up to `to`, every partner is at `from` or later.
+int PeridynamicBonds::firstSelfContained(int from, int to) const {
+    int ready = from;
+    const int last = int(std::min<std::int64_t>(to, std::int64_t(from) + reach_));
+    for (int i = from; i < last; ++i)
+        if (lowestPartner_[i] < from) ready = i + 1;
+    return std::min(ready, to);
+}
+
 void PeridynamicBonds::setUpPairArrays() {
     if (!vectorised()) return;
+    lowestPartner_.resize(bonds_.particleCount());
+    reach_ = 0;
+    for (int i = 0; i < bonds_.particleCount(); ++i) {
+        lowestPartner_[i] = i;
+        for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
+            lowestPartner_[i] = std::min(lowestPartner_[i], bonds_.partners[b]);
+        reach_ = std::max(reach_, i - lowestPartner_[i]);
+    }
     const int pairs = pairs_.pairCount();
     pairFirst_.resize(pairs), pairSecond_.resize(pairs);
     pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
@@ -345,17 +362,24 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                             force.data()->data()};
     const int* pairBegin = pairs_.pairBegin.data();
     double stiffest = 1.0;
+    // Each thread takes a run of particles and, block by block, computes their pairs and at
+    // once sums them into the particles whose pairs are all done, while the slots are still in
+    // cache. The first particles of a run also need pairs of the run before: they wait for the
+    // barrier. Each sum is the gather's, in the same order: the same bits.
 #pragma omp parallel if (n >= kParallelThreshold) reduction(max : stiffest)
     {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-        const std::int64_t first = pairBegin[slab_.ghostBegin],
-                           count = pairBegin[slab_.end] - first;
-        stiffest = linearPairForces(in, out, int(first + count * t / threads),
-                                    int(first + count * (t + 1) / threads));
+        const std::int64_t span = slab_.end - slab_.ghostBegin;
+        const int from = slab_.ghostBegin + int(span * t / threads);
+        const int to = slab_.ghostBegin + int(span * (t + 1) / threads);
+        const int ready = std::max(slab_.begin, firstSelfContained(from, to));
+        for (int p = from; p < to; p += kFusedBlock) {
+            const int q = std::min(to, p + kFusedBlock);
+            stiffest = std::max(stiffest, linearPairForces(in, out, pairBegin[p], pairBegin[q]));
+            gatherPairForces(gather, std::max(p, ready), q);
+        }
 #pragma omp barrier
-        const int owned = slab_.end - slab_.begin;
-        gatherPairForces(gather, slab_.begin + int(std::int64_t(owned) * t / threads),
-                         slab_.begin + int(std::int64_t(owned) * (t + 1) / threads));
+        gatherPairForces(gather, std::max(from, slab_.begin), ready);
     }
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
     updates.stiffest = stiffest;

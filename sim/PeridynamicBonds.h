@@ -97,6 +97,10 @@ private:
     void vectorBondForces(const StepState& s, PairWorkspace& work,
                           std::vector<Eigen::Vector3d>& force, Updates& updates) const;
     void setUpPairArrays();
+    /// Particles per block of the fused pair pass and gather.
+    static constexpr int kFusedBlock = 512;
+    /// The first particle of [from, to) from which on every particle's partners are >= from.
+    int firstSelfContained(int from, int to) const;
     /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, and
     /// the power law with a whole exponent and no maps of its parameters.
     bool vectorised() const;
@@ -119,6 +123,8 @@ private:
     /// critical stretch (sim/PairKernels.h).
     std::vector<int> pairFirst_, pairSecond_, pairUpper_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
+    std::vector<int> lowestPartner_;  ///< per particle: its lowest partner, or itself
+    int reach_ = 0;                   ///< the largest i - lowestPartner_[i]
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     Material material_;

@@ -112,12 +112,20 @@ void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
     const int n = int(theta.size());
     scratch_.resize(n);
     const int first = domain_ ? domain_->slab().begin : 0, last = domain_ ? domain_->slab().end : n;
+    // Local restrict pointers: through the members, each store to scratch_ would reload them.
+    const int* __restrict offsets = bonds.offsets.data();
+    const int* __restrict partners = bonds.partners.data();
+    const std::uint8_t* __restrict living = alive.data();
+    const double* __restrict rate = rate_.data();
+    const double* __restrict now = theta.data();
+    double* __restrict next = scratch_.data();
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
     for (int i = first; i < last; ++i) {
         double flux = 0.0;
-        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
-            if (alive[b]) flux += rate_[b] * (theta[bonds.partners[b]] - theta[i]);
-        scratch_[i] = theta[i] + dt * flux;
+        const double own = now[i];
+        for (int b = offsets[i]; b < offsets[i + 1]; ++b)
+            if (living[b]) flux += rate[b] * (now[partners[b]] - own);
+        next[i] = own + dt * flux;
     }
     theta.swap(scratch_);
     for (const Spot& spot : spots_)  // serial, in a fixed order: identical for any thread count

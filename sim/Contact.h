@@ -34,6 +34,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -62,6 +63,16 @@ public:
     void place(double t);
     std::span<const ColliderPose> poses() const { return poses_; }
     std::span<const ColliderParams> colliders() const { return params_.colliders; }
+
+    static constexpr double kNoFloor = -std::numeric_limits<double>::infinity();
+    /// Where the ground is the only collider, the height below which resolveColliders moves a
+    /// free particle; kNoFloor otherwise.
+    double groundOnlyFloor() const {
+        return params_.ground.enabled && params_.colliders.empty() ? params_.ground.height + offset_
+                                                                   : kNoFloor;
+    }
+    /// What resolveColliders records when it moves no particle (the caller knows it would not).
+    void touchNothing() { impulse_.setZero(); }
 
     /// After a drift to the colliders' current pose: moves the particles for which `free` is
     /// set out of the ground and the colliders, with friction on their velocities. Records each

@@ -200,15 +200,17 @@ void Membrane::integrate(double dt, double tNext) {
         solver_->transferMomentum({x_, mass_, free_, dt, contact_ ? &*contact_ : nullptr}, v_);
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
         for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
+        collide(tNext);
     } else {
-        kickAndDrift(kickDt, dt, tNext);
+        collide(tNext, kickAndDrift(kickDt, dt, tNext));
     }
-    collide(tNext);
     if (domain_) exchangeMotion();
 }
 
 // updateVelocity and the drift in one pass (sim/StepKernels.h: the same bits), by blocks.
-void Membrane::kickAndDrift(double h, double dt, double tNext) {
+// Returns whether a free particle may touch the ground where the ground is the only collider
+// (true wherever there are other colliders or none of this kind).
+bool Membrane::kickAndDrift(double h, double dt, double tNext) {
     std::vector<double> prescribed(3 * params_.boundaries.size());
     for (std::size_t b = 0; b < params_.boundaries.size(); ++b) {
         const Eigen::Vector3d velocity = boundaryVelocity(int(b), tNext);
@@ -225,18 +227,28 @@ void Membrane::kickAndDrift(double h, double dt, double tNext) {
                 {},
                 params_.damping};
     for (int a = 0; a < 3; ++a) k.gravity[a] = params_.gravity[a];
+    const double floor = contact_ ? contact_->groundOnlyFloor() : Contact::kNoFloor;
+    k.floor = floor;
     constexpr int kBlock = 1024;
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold)
+    bool below = false;
+#pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold) \
+    reduction(||                                                                   \
+              : below)
     for (int b = 0; b < blocks; ++b)
-        kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock));
+        below =
+            kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock)) || below;
+    return floor == Contact::kNoFloor || below;
 }
 
-void Membrane::collide(double tNext) {
+void Membrane::collide(double tNext, bool mayTouch) {
     if (!contact_ || !contact_->hasColliders()) return;
     const double t0 = omp_get_wtime();
     contact_->place(tNext);
-    contact_->resolveColliders(x_, v_, mass_, free_, begin_, end_);
+    if (mayTouch)
+        contact_->resolveColliders(x_, v_, mass_, free_, begin_, end_);
+    else
+        contact_->touchNothing();
     contactSeconds_ += omp_get_wtime() - t0;
 }
 

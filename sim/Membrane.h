@@ -188,10 +188,12 @@ private:
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
     void integrate(double h, double tNext);
-    /// integrate's kick of h and drift of dt over this process's particles (not the MPM's).
-    void kickAndDrift(double h, double dt, double tNext);
-    /// Contact after a drift to tNext: the colliders placed there push the free particles out.
-    void collide(double tNext);
+    /// integrate's kick of h and drift of dt over this process's particles (not the MPM's);
+    /// false where the ground is the only collider and no free particle reached it.
+    bool kickAndDrift(double h, double dt, double tNext);
+    /// Contact after a drift to tNext: the colliders placed there push the free particles out
+    /// (`mayTouch` false: the drift found that nothing touches them).
+    void collide(double tNext, bool mayTouch = true);
     void setUpContact(const MembraneParams& params);
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();

@@ -3,11 +3,12 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstdlib>
-#include <string_view>
+#include <cstring>
 
 #include "sim/BondLaw.h"
+#include "sim/StepKernels.h"
 
 namespace rend::sim {
 namespace {
@@ -104,6 +105,19 @@ void gatherLoop(const PairGather& g, int begin, int end) {
         for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
     }
 }
+
+/// Bit k of `bits` as byte k (0 or 1) of the result: one store for a mask's lanes.
+constexpr std::uint64_t laneBytesOf(unsigned bits) {
+    std::uint64_t bytes = 0;
+    for (int k = 0; k < 8; ++k) bytes |= std::uint64_t((bits >> k) & 1u) << (8 * k);
+    return bytes;
+}
+constexpr auto kLaneBytes = [] {
+    std::array<std::uint64_t, 256> table{};
+    for (unsigned bits = 0; bits < 256; ++bits) table[bits] = laneBytesOf(bits);
+    return table;
+}();
+inline std::uint64_t laneBytes(unsigned bits) { return kLaneBytes[bits & 255u]; }
 
 #if defined(__x86_64__)
 #pragma GCC push_options
@@ -249,27 +263,15 @@ struct Simd {
     }
 }
 
-bool hasAvx2() {
-    static const bool has = __builtin_cpu_supports("avx2");
-    return has;
-}
-
-/// REND_SIMD=avx2 keeps a CPU with AVX-512 on the four-lane kernel (for comparing them).
-bool hasAvx512() {
-    static const bool has =
-        __builtin_cpu_supports("avx512f") &&
-        std::string_view(std::getenv("REND_SIMD") ? std::getenv("REND_SIMD") : "") != "avx2";
-    return has;
-}
 #endif
 
 template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = 1.0;
 #if defined(__x86_64__)
-    if (hasAvx512())
+    if (simdWidth() == 8)
         begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
-    else if (hasAvx2())
+    else if (simdWidth() == 4)
         begin = avx2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
 #endif
     return std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end));
@@ -303,7 +305,7 @@ double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, 
 
 void gatherPairForces(const PairGather& g, int begin, int end) {
 #if defined(__x86_64__)
-    if (hasAvx2()) return gatherAvx2(g, begin, end);
+    if (simdWidth() >= 4) return gatherAvx2(g, begin, end);
 #endif
     gatherLoop(g, begin, end);
 }

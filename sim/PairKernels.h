@@ -5,8 +5,7 @@
 // of pairs. sim/PeridynamicBonds.cpp gathers the pair forces per particle. Eight pairs at a time
 // with AVX-512 where the CPU has it, else four with AVX2, else one at a time
 // (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt (no
-// fused multiply-add), so their bits are the same. REND_SIMD=avx2 in the environment keeps a CPU on
-// four lanes.
+// fused multiply-add), so their bits are the same. The width is sim/StepKernels.h's simdWidth().
 
 #include <cstdint>
 

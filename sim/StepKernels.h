@@ -1,7 +1,9 @@
 #pragma once
-// Eq. 26's kick and drift in one pass over a range of particles, four free particles at a time
-// with AVX2 where the CPU has it, else one at a time. Both use only +, -, * and / (no fused
-// multiply-add), in the order of Membrane::updateVelocity, so their bits are the same.
+// Eq. 26's kick and drift in one pass over a range of particles, eight free particles at a time
+// with AVX-512 or four with AVX2 where the CPU has it, else one at a time. All use only +, -, *
+// and / (no fused multiply-add), in the order of Membrane::updateVelocity, so their bits are the
+// same. The pass also tells whether any free particle ended up not above a floor, so that a
+// scene whose only collider is the ground skips the contact pass on the steps nothing touches.
 
 #include <cstdint>
 #include <span>
@@ -21,10 +23,17 @@ struct KickDrift {
     double dt = 0.0;  ///< the drift
     double gravity[3] = {0.0, 0.0, 0.0};
     double damping = 0.0;
+    double floor = -1.0 / 0.0;  ///< the ground's contact height; -inf: none
 };
 
 /// Particles [begin, end): v += h (f / m + g - damping v) for the free ones, the pinned at rest,
-/// the driven at their boundary's velocity; then x += dt v.
-void kickDrift(const KickDrift& k, int begin, int end);
+/// the driven at their boundary's velocity; then x += dt v. Returns whether a free particle's z
+/// is not >= k.floor afterwards (NaN counts).
+bool kickDrift(const KickDrift& k, int begin, int end);
+
+/// Lanes of the vector kernels here and in sim/PairKernels.h: 8 with AVX-512, 4 with AVX2, 1
+/// without. REND_SIMD=avx2 or REND_SIMD=scalar in the environment caps it (to compare them; every
+/// width gives the same bits).
+int simdWidth();
 
 }  // namespace rend::sim

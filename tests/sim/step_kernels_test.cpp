@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "sim/Random.h"
@@ -20,7 +21,8 @@ struct Particles {
     std::vector<std::int16_t> constraint;
 };
 
-/// n particles with values of every size; every seventh pinned, every eleventh driven.
+/// n particles with values of every size; every 37th pinned, every 41st driven (most blocks of
+/// eight are all free, and take the vector path).
 Particles someParticles(int n) {
     Particles p;
     const auto r = [](int i, int k) { return uniformFromHash(77, 8 * std::uint64_t(i) + k); };
@@ -29,7 +31,7 @@ Particles someParticles(int n) {
         p.v.emplace_back(r(i, 3) - 0.5, 1e-3 * r(i, 4), -r(i, 5));
         p.force.emplace_back(1e6 * (r(i, 6) - 0.5), 3.0 * r(i, 7), -1e-9 * r(i, 0));
         p.mass.push_back(1e-6 + r(i, 1) * 1e-3);
-        p.constraint.push_back(i % 7 == 3 ? -2 : i % 11 == 5 ? std::int16_t(i % 2) : -1);
+        p.constraint.push_back(i % 37 == 3 ? -2 : i % 41 == 5 ? std::int16_t(i % 2) : -1);
     }
     return p;
 }
@@ -70,11 +72,52 @@ TEST(KickDrift, GivesTheBitsOfTheEigenStepForEveryConstraint) {
                     {},
                     damping};
         for (int a = 0; a < 3; ++a) k.gravity[a] = gravity[a];
-        kickDrift(k, 0, split);
-        kickDrift(k, split, int(p.x.size()));
+        EXPECT_FALSE(kickDrift(k, 0, split) || kickDrift(k, split, int(p.x.size())))
+            << "no floor: nothing is below it";
         EXPECT_TRUE(sameBits(p.v, expected.v)) << "split at " << split;
         EXPECT_TRUE(sameBits(p.x, expected.x)) << "split at " << split;
     }
+}
+
+// The floor test counts exactly the free particles whose new z is not >= the floor, whichever
+// block of four or eight they sit in; pinned and driven ones never count, and NaN does.
+TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {
+    const Particles start = someParticles(203);
+    const double floor = 10.0;  // every start z is below 0.5
+    for (int i = 0; i < int(start.x.size()); ++i) {
+        Particles p = start;
+        for (int j = 0; j < int(p.x.size()); ++j)
+            if (j != i) p.x[j].z() = 20.0;  // all above but i
+        p.v.assign(p.v.size(), Eigen::Vector3d::Zero());
+        p.force.assign(p.force.size(), Eigen::Vector3d::Zero());
+        const std::vector<double> boundary = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        KickDrift k{p.x.data()->data(),
+                    p.v.data()->data(),
+                    p.force.data()->data(),
+                    p.mass.data(),
+                    p.constraint.data(),
+                    boundary,
+                    1e-4,
+                    1e-4};
+        k.floor = floor;
+        const bool below = kickDrift(k, 0, 100) || kickDrift(k, 100, int(p.x.size()));
+        EXPECT_EQ(below, start.constraint[i] == -1) << "particle " << i;
+    }
+    Particles p = start;
+    for (Eigen::Vector3d& x : p.x) x.z() = 20.0;
+    p.x[150].z() = std::numeric_limits<double>::quiet_NaN();
+    p.constraint[150] = -1;
+    const std::vector<double> boundary(6, 0.0);
+    KickDrift k{p.x.data()->data(),
+                p.v.data()->data(),
+                p.force.data()->data(),
+                p.mass.data(),
+                p.constraint.data(),
+                boundary,
+                1e-4,
+                1e-4};
+    k.floor = floor;
+    EXPECT_TRUE(kickDrift(k, 0, int(p.x.size()))) << "a NaN height is not above the floor";
 }
 
 }  // namespace

@@ -33,6 +33,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
     const double* __restrict x = in.x;
     const double* __restrict theta = in.theta;
     double* __restrict force = out.force;
+    const int base = out.slotBase;
     std::uint8_t* __restrict over = out.over;
     double stiffest = 1.0;
     for (int u = begin; u < end; ++u) {
@@ -85,10 +86,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
         double coef = in.scale[u] * f / length;
         if constexpr (kBreak) coef = past ? 0.0 : coef;
-        force[4 * u] = coef * rx;
-        force[4 * u + 1] = coef * ry;
-        force[4 * u + 2] = coef * rz;
-        force[4 * u + 3] = 0.0;
+        double* slot = force + 4 * std::size_t(u - base);
+        slot[0] = coef * rx, slot[1] = coef * ry, slot[2] = coef * rz, slot[3] = 0.0;
     }
     return stiffest;
 }
@@ -98,10 +97,12 @@ void gatherLoop(const PairGather& g, int begin, int end) {
         double sum[3] = {0.0, 0.0, 0.0};
         for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
             if (g.alive[b])
-                for (int k = 0; k < 3; ++k) sum[k] -= g.pairForce[4 * g.pairOf[b] + k];
+                for (int k = 0; k < 3; ++k)
+                    sum[k] -= g.pairForce[4 * (unsigned(g.pairOf[b]) & g.slotMask) + k];
         for (int b = g.upperBegin[i], u = g.pairBegin[i]; b < g.offsets[i + 1]; ++b, ++u)
             if (g.alive[b])
-                for (int k = 0; k < 3; ++k) sum[k] += g.pairForce[4 * u + k];
+                for (int k = 0; k < 3; ++k)
+                    sum[k] += g.pairForce[4 * (unsigned(u) & g.slotMask) + k];
         for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
     }
 }
@@ -250,13 +251,17 @@ struct Simd {
     const int* __restrict pairOf = g.pairOf;
     const std::uint8_t* __restrict alive = g.alive;
     const double* __restrict pairForce = g.pairForce;
+    const unsigned mask = g.slotMask;
     double* __restrict force = g.force;
     for (int i = begin; i < end; ++i) {
         __m256d sum = _mm256_setzero_pd();
         for (int b = offsets[i]; b < upperBegin[i]; ++b)
-            if (alive[b]) sum = _mm256_sub_pd(sum, _mm256_loadu_pd(pairForce + 4 * pairOf[b]));
+            if (alive[b])
+                sum = _mm256_sub_pd(sum,
+                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
         for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
-            if (alive[b]) sum = _mm256_add_pd(sum, _mm256_loadu_pd(pairForce + 4 * u));
+            if (alive[b])
+                sum = _mm256_add_pd(sum, _mm256_loadu_pd(pairForce + 4 * (unsigned(u) & mask)));
         double lanes[4];
         _mm256_storeu_pd(lanes, sum);
         force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];

@@ -40,8 +40,10 @@ struct LinearPairInput {
 };
 
 struct LinearPairOutput {
-    double* force = nullptr;       ///< per pair: x y z 0, its force on i; zero past its limit
+    /// Per pair u, at slot u - slotBase: x y z 0, its force on i; zero past its limit.
+    double* force = nullptr;
     std::uint8_t* over = nullptr;  ///< per pair: past its limit (only with a limit)
+    int slotBase = 0;
 };
 
 /// Pairs [begin, end). Dead bonds are computed too: the gather skips them. Returns the power
@@ -57,8 +59,9 @@ struct PairGather {
     const int* pairBegin = nullptr;
     const int* pairOf = nullptr;
     const std::uint8_t* alive = nullptr;
-    const double* pairForce = nullptr;  ///< LinearPairOutput::force
+    const double* pairForce = nullptr;  ///< LinearPairOutput::force: pair u at slot u & slotMask
     double* force = nullptr;            ///< x y z per particle
+    unsigned slotMask = ~0u;            ///< a ring of 2^k slots, or all bits: slot u is pair u
 };
 
 /// Particles [begin, end).

@@ -40,25 +40,20 @@ bool PeridynamicBonds::vectorised() const {
     return law_.kind == BondLawKind::PowerLaw && !ownLaws() && (n == 2.0 || n == 3.0 || n == 4.0);
 }
 
-// The first particle from which on, up to `to`, every partner is at `from` or later.
-int PeridynamicBonds::firstSelfContained(int from, int to) const {
-    int ready = from;
-    const int last = int(std::min<std::int64_t>(to, std::int64_t(from) + reach_));
-    for (int i = from; i < last; ++i)
-        if (lowestPartner_[i] < from) ready = i + 1;
-    return std::min(ready, to);
-}
-
 void PeridynamicBonds::setUpPairArrays() {
     if (!vectorised()) return;
-    lowestPartner_.resize(bonds_.particleCount());
     reach_ = 0;
-    for (int i = 0; i < bonds_.particleCount(); ++i) {
-        lowestPartner_[i] = i;
+    for (int i = 0; i < bonds_.particleCount(); ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
-            lowestPartner_[i] = std::min(lowestPartner_[i], bonds_.partners[b]);
-        reach_ = std::max(reach_, i - lowestPartner_[i]);
-    }
+            reach_ = std::max(reach_, i - bonds_.partners[b]);
+    // A ring holds the pairs of the reach_ particles before a block and the block's own.
+    const int n = bonds_.particleCount();
+    int window = 8;
+    for (int i = 0; i < n; ++i)
+        window = std::max(
+            window, pairs_.pairBegin[std::min(n, i + reach_ + kFusedBlock)] - pairs_.pairBegin[i]);
+    ringPairs_ = 1;
+    while (ringPairs_ < window) ringPairs_ *= 2;
     const int pairs = pairs_.pairCount();
     pairFirst_.resize(pairs), pairSecond_.resize(pairs);
     pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
@@ -335,7 +330,8 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                                         Updates& updates) const {
     const int n = bonds_.particleCount(), pairs = pairs_.pairCount();
     force.resize(n);
-    work.slots.resize(4 * std::size_t(pairs));
+    const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
+    work.slots.resize(4 * std::size_t(ringPairs_) * teams);
     if (kBreak) work.over.resize(pairs);
     LinearPairInput in{pairFirst_.data(),
                        pairSecond_.data(),
@@ -355,31 +351,45 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
     in.twin = pairs_.twin.data();
     in.plastic = kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data());
-    const LinearPairOutput out{work.slots.data(), work.over.data()};
-    const PairGather gather{bonds_.offsets.data(),       pairs_.upperBegin.data(),
-                            pairs_.pairBegin.data(),     pairs_.pairOf.data(),
-                            damage_->bondAlive().data(), work.slots.data(),
-                            force.data()->data()};
+    LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
+    halo.update = false;
     const int* pairBegin = pairs_.pairBegin.data();
     double stiffest = 1.0;
-    // Each thread takes a run of particles and, block by block, computes their pairs and at
-    // once sums them into the particles whose pairs are all done, while the slots are still in
-    // cache. The first particles of a run also need pairs of the run before: they wait for the
-    // barrier. Each sum is the gather's, in the same order: the same bits.
+    // Each thread takes a run of particles and, block by block, computes their pairs into its
+    // own ring of slots and at once sums them into the block's particles, while the slots are
+    // in cache (a ring, so that they never go to memory). A particle's lower copies reach back
+    // at most reach_ particles: each thread first computes the pairs of the reach_ particles
+    // before its run (read-only, before the barrier, so before any owner moves the histories
+    // on). Every slot holds the bits the owner computes, and each sum is in the gather's order:
+    // the same bits for any thread count.
 #pragma omp parallel if (n >= kParallelThreshold) reduction(max : stiffest)
     {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
         const std::int64_t span = slab_.end - slab_.ghostBegin;
         const int from = slab_.ghostBegin + int(span * t / threads);
         const int to = slab_.ghostBegin + int(span * (t + 1) / threads);
-        const int ready = std::max(slab_.begin, firstSelfContained(from, to));
+        double* ring = work.slots.data() + 4 * std::size_t(ringPairs_) * t;
+        const auto compute = [&](const LinearPairInput& input, int p, int q) {
+            double most = 1.0;
+            for (int u = pairBegin[p], end = pairBegin[q]; u < end;) {  // split where it wraps
+                const int base = u - int(unsigned(u) & (ringPairs_ - 1));
+                const int stop = std::min(end, base + ringPairs_);
+                most = std::max(most,
+                                linearPairForces(input, {ring, work.over.data(), base}, u, stop));
+                u = stop;
+            }
+            return most;
+        };
+        compute(halo, std::max(slab_.ghostBegin, from - reach_), from);
+#pragma omp barrier
+        PairGather gather{bonds_.offsets.data(), pairs_.upperBegin.data(),    pairBegin,
+                          pairs_.pairOf.data(),  damage_->bondAlive().data(), ring,
+                          force.data()->data(),  unsigned(ringPairs_ - 1)};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
-            stiffest = std::max(stiffest, linearPairForces(in, out, pairBegin[p], pairBegin[q]));
-            gatherPairForces(gather, std::max(p, ready), q);
+            stiffest = std::max(stiffest, compute(in, p, q));
+            gatherPairForces(gather, std::max(p, slab_.begin), q);
         }
-#pragma omp barrier
-        gatherPairForces(gather, std::max(from, slab_.begin), ready);
     }
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
     updates.stiffest = stiffest;

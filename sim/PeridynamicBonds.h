@@ -89,7 +89,7 @@ private:
     /// as three arrays, and whether it is past its limit).
     struct PairWorkspace : Workspace {
         std::vector<Eigen::Vector3d> pairForce;
-        std::vector<double> slots;  ///< the linear law's: x y z 0 per pair
+        std::vector<double> slots;  ///< the vectorised laws': a ring of x y z 0 per thread
         std::vector<std::uint8_t> over;
     };
     /// The vectorised laws' loop: sim/PairKernels.h's first pass, then the gather.
@@ -99,8 +99,6 @@ private:
     void setUpPairArrays();
     /// Particles per block of the fused pair pass and gather.
     static constexpr int kFusedBlock = 512;
-    /// The first particle of [from, to) from which on every particle's partners are >= from.
-    int firstSelfContained(int from, int to) const;
     /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, and
     /// the power law with a whole exponent and no maps of its parameters.
     bool vectorised() const;
@@ -123,8 +121,9 @@ private:
     /// critical stretch (sim/PairKernels.h).
     std::vector<int> pairFirst_, pairSecond_, pairUpper_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
-    std::vector<int> lowestPartner_;  ///< per particle: its lowest partner, or itself
-    int reach_ = 0;                   ///< the largest i - lowestPartner_[i]
+    int reach_ = 0;  ///< the largest i - j over bonds i -> j: how far back a lower copy lies
+    int ringPairs_ =
+        1;  ///< slots in each thread's ring: a power of 2 >= any reach_ + block's pairs
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     Material material_;

@@ -2,6 +2,7 @@
 // bits of the loop over both copies of every bond, for every law, with theta and breaking.
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cstring>
 #include <vector>
@@ -46,6 +47,9 @@ TEST(BondPairs, NumberEachBondOnceThroughItsUpperCopy) {
 struct Case {
     BondLawKind law;
     bool theta, breakable;
+    /// A sheet of 1 x 0.5 m: ~5,800 particles, over the threads' threshold, and more pairs
+    /// than a thread's ring of slots holds (sim/PeridynamicBonds.h), so that it wraps.
+    bool large = false;
 };
 
 /// Particle i's force summed over both copies of its bonds, one at a time: the loop as the
@@ -79,7 +83,7 @@ class PairLoop : public ::testing::TestWithParam<Case> {};
 TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     const Case c = GetParam();
     MembraneParams p;
-    p.sheet.size = {0.2, 0.1};
+    p.sheet.size = c.large ? Eigen::Vector2d(1.0, 0.5) : Eigen::Vector2d(0.2, 0.1);
     p.sheet.dx = 0.01;
     p.material.youngsModulus = 1e5;
     p.material.law = c.law;
@@ -106,15 +110,20 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
             x[i][a] += 2.0 * etaC * p.sheet.dx * (2.0 * uniformFromHash(7, 3 * i + a) - 1.0);
         if (c.theta) theta.push_back(2.0 * uniformFromHash(8, i));
     }
-    std::vector<Eigen::Vector3d> force;
-    solver.forces({x, v, theta, 1e-4}, *solver.makeWorkspace(), force);
     const std::vector<Eigen::Vector3d> expected =
         bothCopies(solver, bonds, damage, p.material, x, theta);
-    ASSERT_EQ(force.size(), expected.size());
-    EXPECT_EQ(std::memcmp(force.data(), expected.data(), n * sizeof(Eigen::Vector3d)), 0);
-    int differ = 0;
-    for (int i = 0; i < n; ++i) differ += force[i] != expected[i];
-    EXPECT_EQ(differ, 0) << "of " << n << " particles";
+    const int before = omp_get_max_threads();
+    for (const int threads : {1, 3}) {
+        omp_set_num_threads(threads);
+        std::vector<Eigen::Vector3d> force;
+        solver.forces({x, v, theta, 1e-4}, *solver.makeWorkspace(), force);
+        ASSERT_EQ(force.size(), expected.size());
+        EXPECT_EQ(std::memcmp(force.data(), expected.data(), n * sizeof(Eigen::Vector3d)), 0);
+        int differ = 0;
+        for (int i = 0; i < n; ++i) differ += force[i] != expected[i];
+        EXPECT_EQ(differ, 0) << "of " << n << " particles, " << threads << " threads";
+    }
+    omp_set_num_threads(before);
 }
 
 TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
@@ -215,7 +224,10 @@ INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                                            Case{BondLawKind::PowerLaw, false, false},
                                            Case{BondLawKind::PowerLaw, true, true},
                                            Case{BondLawKind::Elastoplastic, false, true},
-                                           Case{BondLawKind::Elastoplastic, true, true}));
+                                           Case{BondLawKind::Elastoplastic, true, true},
+                                           Case{BondLawKind::Linear, true, true, true},
+                                           Case{BondLawKind::PowerLaw, true, true, true},
+                                           Case{BondLawKind::Elastoplastic, true, true, true}));
 
 TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
     const BondFamilies bonds = sheetBonds(0.3, 0.2, 1.5);

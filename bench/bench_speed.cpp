@@ -9,6 +9,7 @@
 // breaking on), both square at dt 1e-4.
 //
 //   build/bench_speed [--largest N]   (default 10000000; sizes 1e4, 1e5, 1e6, 1e7 up to it)
+//   REND_SIMD=avx2 build/bench_speed  (the four-lane kernels on a CPU with AVX-512)
 
 #include <omp.h>
 #include <unistd.h>
@@ -27,6 +28,7 @@
 #include "app/Scene.h"
 #include "app/Threads.h"
 #include "sim/Membrane.h"
+#include "sim/StepKernels.h"
 
 namespace {
 
@@ -146,9 +148,14 @@ int main(int argc, char** argv) {
     const rend::Scene scene = rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/stretch.toml",
                                               {"sheet.lattice=\"square\"", "time.dt=1e-4"});
     const int cores = rend::usableCores();
+    const int width = rend::sim::simdWidth();
     std::printf(
-        "scenes/stretch.toml, square lattice, dt 1e-4, peridynamic bonds; %d usable cores\n",
-        cores);
+        "scenes/stretch.toml, square lattice, dt 1e-4, peridynamic bonds; %d usable cores; "
+        "kernels %d lanes wide (%s)\n",
+        cores, width,
+        width == 8   ? "AVX-512"
+        : width == 4 ? "AVX2"
+                     : "scalar");
     std::printf("%12s %10s %12s %10s %14s %14s %8s\n", "particles", "bonds/p", "bytes/p", "setup s",
                 "ns/p-step 1t", "ns/p-step all", "speedup");
     double rendAt1e4 = 0.0;

@@ -126,19 +126,37 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     omp_set_num_threads(before);
 }
 
-TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
+/// A 0.2 x 0.1 m sheet at dx 0.01 with bonds within 1.5 dx, and its solver and damage bound.
+struct SmallSheet {
+    explicit SmallSheet(const MembraneParams& params)
+        : p(params),
+          lattice(generateLattice(p.sheet)),
+          bonds(buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx)),
+          volumes(lattice.positions.size(), lattice.particleArea * p.sheet.thickness),
+          solver(p, lattice, bonds, lattice.positions, volumes),
+          damage(bonds, lattice.triangles) {
+        solver.bind(bonds, damage);
+    }
+    static MembraneParams params(BondLawKind law) {
+        MembraneParams p;
+        p.sheet.size = {0.2, 0.1};
+        p.sheet.dx = 0.01;
+        p.material.youngsModulus = 1e5;
+        p.material.law = law;
+        p.material.yieldStrain = 0.002;
+        return p;
+    }
     MembraneParams p;
-    p.sheet.size = {0.2, 0.1};
-    p.sheet.dx = 0.01;
-    p.material.youngsModulus = 1e5;
-    p.material.law = BondLawKind::PowerLaw;
-    const Lattice lattice = generateLattice(p.sheet);
-    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx);
-    const std::vector<double> volumes(lattice.positions.size(),
-                                      lattice.particleArea * p.sheet.thickness);
-    PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
-    DamageState damage(bonds, lattice.triangles);
-    solver.bind(bonds, damage);
+    Lattice lattice;
+    BondFamilies bonds;
+    std::vector<double> volumes;
+    PeridynamicBonds solver;
+    DamageState damage;
+};
+
+TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
+    SmallSheet sheet(SmallSheet::params(BondLawKind::PowerLaw));
+    auto& [p, lattice, bonds, volumes, solver, damage] = sheet;
     const int n = int(lattice.positions.size());
     std::vector<Eigen::Vector3d> x = lattice.positions, v(n);
     for (int i = 0; i < n; ++i)
@@ -176,19 +194,8 @@ TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
 // advance() moves the elastoplastic history on in the kernel: both copies of every living,
 // unbroken bond hold the largest strain it has seen, and a dead bond's history stays put.
 TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {
-    MembraneParams p;
-    p.sheet.size = {0.2, 0.1};
-    p.sheet.dx = 0.01;
-    p.material.youngsModulus = 1e5;
-    p.material.law = BondLawKind::Elastoplastic;
-    p.material.yieldStrain = 0.002;
-    const Lattice lattice = generateLattice(p.sheet);
-    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * p.sheet.dx);
-    const std::vector<double> volumes(lattice.positions.size(),
-                                      lattice.particleArea * p.sheet.thickness);
-    PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
-    DamageState damage(bonds, lattice.triangles);
-    solver.bind(bonds, damage);
+    SmallSheet sheet(SmallSheet::params(BondLawKind::Elastoplastic));
+    auto& [p, lattice, bonds, volumes, solver, damage] = sheet;
     for (int b = 0; b < int(bonds.directedCount()); b += 29) damage.breakBond(b);
     const int n = int(lattice.positions.size());
     std::vector<double> largest(bonds.directedCount(), 0.0);
@@ -239,7 +246,9 @@ TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
         EXPECT_EQ(slabs.back().end, n);
         for (int r = 0; r < count; ++r) {
             const Slab& s = slabs[r];
-            if (r > 0) EXPECT_EQ(s.begin, slabs[r - 1].end);
+            if (r > 0) {
+                EXPECT_EQ(s.begin, slabs[r - 1].end);
+            }
             // Every pair from [ghostBegin, end) and every owned particle's partner is held.
             for (int i = s.ghostBegin; i < s.end; ++i)
                 for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
@@ -249,7 +258,9 @@ TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
                         EXPECT_LT(j, s.ghostEnd);
                     }
                 }
-            if (r > 0) EXPECT_GE(s.ghostBegin, slabs[r - 1].begin) << "only the next slab";
+            if (r > 0) {
+                EXPECT_GE(s.ghostBegin, slabs[r - 1].begin) << "only the next slab";
+            }
         }
     }
     EXPECT_THROW(partitionSlabs(bonds, n / 10), std::invalid_argument) << "slabs of 10";

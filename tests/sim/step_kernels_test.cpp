@@ -36,6 +36,18 @@ Particles someParticles(int n) {
     return p;
 }
 
+/// The kernel's view of `p`, stepping h and dt, with `boundary`'s velocities.
+KickDrift viewOf(Particles& p, const std::vector<double>& boundary, double h, double dt) {
+    return {p.x.data()->data(),
+            p.v.data()->data(),
+            p.force.data()->data(),
+            p.mass.data(),
+            p.constraint.data(),
+            boundary,
+            h,
+            dt};
+}
+
 bool sameBits(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0;
 }
@@ -61,16 +73,8 @@ TEST(KickDrift, GivesTheBitsOfTheEigenStepForEveryConstraint) {
     // Whole, and split at a point that is not a multiple of four (a thread's range).
     for (const int split : {0, 1, 6, 101}) {
         Particles p = start;
-        KickDrift k{p.x.data()->data(),
-                    p.v.data()->data(),
-                    p.force.data()->data(),
-                    p.mass.data(),
-                    p.constraint.data(),
-                    boundary,
-                    h,
-                    dt,
-                    {},
-                    damping};
+        KickDrift k = viewOf(p, boundary, h, dt);
+        k.damping = damping;
         for (int a = 0; a < 3; ++a) k.gravity[a] = gravity[a];
         EXPECT_FALSE(kickDrift(k, 0, split) || kickDrift(k, split, int(p.x.size())))
             << "no floor: nothing is below it";
@@ -91,14 +95,7 @@ TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {
         p.v.assign(p.v.size(), Eigen::Vector3d::Zero());
         p.force.assign(p.force.size(), Eigen::Vector3d::Zero());
         const std::vector<double> boundary = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-        KickDrift k{p.x.data()->data(),
-                    p.v.data()->data(),
-                    p.force.data()->data(),
-                    p.mass.data(),
-                    p.constraint.data(),
-                    boundary,
-                    1e-4,
-                    1e-4};
+        KickDrift k = viewOf(p, boundary, 1e-4, 1e-4);
         k.floor = floor;
         const bool below = kickDrift(k, 0, 100) || kickDrift(k, 100, int(p.x.size()));
         EXPECT_EQ(below, start.constraint[i] == -1) << "particle " << i;
@@ -108,14 +105,7 @@ TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {
     p.x[150].z() = std::numeric_limits<double>::quiet_NaN();
     p.constraint[150] = -1;
     const std::vector<double> boundary(6, 0.0);
-    KickDrift k{p.x.data()->data(),
-                p.v.data()->data(),
-                p.force.data()->data(),
-                p.mass.data(),
-                p.constraint.data(),
-                boundary,
-                1e-4,
-                1e-4};
+    KickDrift k = viewOf(p, boundary, 1e-4, 1e-4);
     k.floor = floor;
     EXPECT_TRUE(kickDrift(k, 0, int(p.x.size()))) << "a NaN height is not above the floor";
 }

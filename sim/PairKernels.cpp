@@ -121,8 +121,14 @@ constexpr auto kLaneBytes = [] {
 inline std::uint64_t laneBytes(unsigned bits) { return kLaneBytes[bits & 255u]; }
 
 #if defined(__x86_64__)
+// Each width's code is compiled for its instruction set: GCC by `#pragma GCC target`, clang (the
+// fuzz build) by `#pragma clang attribute`.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace avx2 {
 
 using V = __m256d;
@@ -182,10 +188,14 @@ struct Simd {
 #include "sim/PairKernelSimd.inc"
 
 }  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#pragma clang attribute push(__attribute__((target("avx2,avx512f"))), apply_to = function)
+#else
 #pragma GCC pop_options
-
 #pragma GCC push_options
 #pragma GCC target("avx2,avx512f")
+#endif
 namespace avx512 {
 
 using V = __m512d;
@@ -241,7 +251,11 @@ struct Simd {
 #include "sim/PairKernelSimd.inc"
 
 }  // namespace avx512
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 // A pair force is one four-lane load; the lanes add as the scalar sums do.
 [[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {

@@ -324,20 +324,13 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
     updates.stiffest = stiffest;
 }
 
-template <bool kUpdateBonds, bool kBreak>
-void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
-                                        std::vector<Eigen::Vector3d>& force,
-                                        Updates& updates) const {
-    const int n = bonds_.particleCount(), pairs = pairs_.pairCount();
-    force.resize(n);
-    const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
-    work.slots.resize(4 * std::size_t(ringPairs_) * teams);
-    if (kBreak) work.over.resize(pairs);
+LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, bool breakable,
+                                            PlasticState* plastic) const {
     LinearPairInput in{pairFirst_.data(),
                        pairSecond_.data(),
                        pairRest_.data(),
                        pairScale_.data(),
-                       kBreak ? pairLimit_.data() : nullptr,
+                       breakable ? pairLimit_.data() : nullptr,
                        s.x.data()->data(),
                        s.theta.empty() ? nullptr : s.theta.data(),
                        law_.c,
@@ -346,11 +339,26 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                        material_.params().strengthLoss};
     in.law = &law_;
     in.powerC = law_.powerC, in.powerCStar = law_.powerCStar, in.powerN = law_.powerN;
-    in.update = kUpdateBonds;
-    in.v = kUpdateBonds ? s.v.data()->data() : nullptr, in.dt = s.dt;
+    in.update = update;
+    in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
     in.twin = pairs_.twin.data();
-    in.plastic = kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data());
+    in.plastic = plastic;
+    return in;
+}
+
+template <bool kUpdateBonds, bool kBreak>
+void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
+                                        std::vector<Eigen::Vector3d>& force,
+                                        Updates& updates) const {
+    const int n = bonds_.particleCount();
+    force.resize(n);
+    const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
+    work.slots.resize(4 * std::size_t(ringPairs_) * teams);
+    if (kBreak) work.over.resize(pairs_.pairCount());
+    const LinearPairInput in =
+        pairInput(s, kUpdateBonds, kBreak,
+                  kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data()));
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
     const int* pairBegin = pairs_.pairBegin.data();

@@ -24,6 +24,8 @@
 
 namespace rend::sim {
 
+struct LinearPairInput;  // sim/PairKernels.h
+
 class PeridynamicBonds final : public Solver {
 public:
     /// `bonds` is the Membrane's (kept by reference), `rest` and `volumes` its rest positions
@@ -92,15 +94,19 @@ private:
         std::vector<double> slots;  ///< the vectorised laws': a ring of x y z 0 per thread
         std::vector<std::uint8_t> over;
     };
-    /// The vectorised laws' loop: sim/PairKernels.h's first pass, then the gather.
+    /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
+    LinearPairInput pairInput(const StepState& s, bool update, bool breakable,
+                              PlasticState* plastic) const;
+    /// The vectorised laws' loop: sim/PairKernels.h's pairs and their sums, fused per thread.
     template <bool kUpdateBonds, bool kBreak>
     void vectorBondForces(const StepState& s, PairWorkspace& work,
                           std::vector<Eigen::Vector3d>& force, Updates& updates) const;
     void setUpPairArrays();
     /// Particles per block of the fused pair pass and gather.
     static constexpr int kFusedBlock = 512;
-    /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, and
-    /// the power law with a whole exponent and no maps of its parameters.
+    /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, the
+    /// power law with a whole exponent and the elastoplastic law, without maps of their own
+    /// parameters.
     bool vectorised() const;
     int proposeBreaks(const std::vector<std::uint8_t>& over, std::uint8_t* proposed) const;
     double strainEnergyOf(const StepState& s, int begin, int end) const;

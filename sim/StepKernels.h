@@ -6,6 +6,7 @@
 // scene whose only collider is the ground skips the contact pass on the steps nothing touches.
 
 #include <cstdint>
+#include <limits>
 #include <span>
 
 namespace rend::sim {
@@ -23,7 +24,7 @@ struct KickDrift {
     double dt = 0.0;  ///< the drift
     double gravity[3] = {0.0, 0.0, 0.0};
     double damping = 0.0;
-    double floor = -1.0 / 0.0;  ///< the ground's contact height; -inf: none
+    double floor = -std::numeric_limits<double>::infinity();  ///< the ground's height; -inf: none
 };
 
 /// Particles [begin, end): v += h (f / m + g - damping v) for the free ones, the pinned at rest,

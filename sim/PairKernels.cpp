@@ -99,10 +99,10 @@ void gatherLoop(const PairGather& g, int begin, int end) {
             if (g.alive[b])
                 for (int k = 0; k < 3; ++k)
                     sum[k] -= g.pairForce[4 * (unsigned(g.pairOf[b]) & g.slotMask) + k];
-        for (int b = g.upperBegin[i], u = g.pairBegin[i]; b < g.offsets[i + 1]; ++b, ++u)
+        for (int b = g.upperBegin[i]; b < g.offsets[i + 1]; ++b)
             if (g.alive[b])
                 for (int k = 0; k < 3; ++k)
-                    sum[k] += g.pairForce[4 * (unsigned(u) & g.slotMask) + k];
+                    sum[k] += g.pairForce[4 * (unsigned(g.pairOf[b]) & g.slotMask) + k];
         for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
     }
 }
@@ -160,6 +160,28 @@ struct Simd {
     template <class Read>
     [[gnu::always_inline]] static V lanes(Read read) {
         return _mm256_setr_pd(read(0), read(1), read(2), read(3));
+    }
+    /// base[index[k]] for four lanes: one hardware gather.
+    [[gnu::always_inline]] static V gather(const double* base, const int* index) {
+        return _mm256_i32gather_pd(base, _mm_loadu_si128(reinterpret_cast<const __m128i*>(index)),
+                                   8);
+    }
+    /// Whether index[0..3] are consecutive: a run of particles.
+    [[gnu::always_inline]] static bool consecutive(const int* index) {
+        const __m128i at = _mm_loadu_si128(reinterpret_cast<const __m128i*>(index));
+        const __m128i run = _mm_add_epi32(_mm_set1_epi32(index[0]), _mm_setr_epi32(0, 1, 2, 3));
+        return _mm_movemask_epi8(_mm_cmpeq_epi32(at, run)) == 0xffff;
+    }
+    /// The x, y and z of four consecutive particles from p (the first's x): three loads.
+    [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {
+        const V a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
+        // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+        x = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0100), c, 0b0010),
+                                  _MM_SHUFFLE(1, 2, 3, 0));
+        y = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b1001), c, 0b0100),
+                                  _MM_SHUFFLE(2, 3, 0, 1));
+        z = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0010), c, 0b1001),
+                                  _MM_SHUFFLE(3, 0, 1, 2));
     }
     /// The x, y and z of four particles from plain loads: AMD's gathers cost more.
     [[gnu::always_inline]] static void loadPositions(const double* p, const int* index, V& x, V& y,
@@ -230,6 +252,30 @@ struct Simd {
         return _mm512_setr_pd(read(0), read(1), read(2), read(3), read(4), read(5), read(6),
                               read(7));
     }
+    /// base[index[k]] for eight lanes: one hardware gather.
+    [[gnu::always_inline]] static V gather(const double* base, const int* index) {
+        return _mm512_i32gather_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)),
+                                   base, 8);
+    }
+    [[gnu::always_inline]] static bool consecutive(const int* index) {
+        const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
+        const __m256i run = _mm256_add_epi32(_mm256_set1_epi32(index[0]),
+                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        return unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi32(at, run))) == 0xffffffffu;
+    }
+    [[gnu::always_inline]] static V pick(V lo, V hi, __m512i from) {
+        return _mm512_permutex2var_pd(lo, from, hi);
+    }
+    /// Eight consecutive particles' x, y and z from p: three loads, six permutes.
+    [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {
+        const V a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);
+        x = pick(pick(a, b, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0)), c,
+                 _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13));
+        y = pick(pick(a, b, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0)), c,
+                 _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14));
+        z = pick(pick(a, b, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0)), c,
+                 _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
+    }
     [[gnu::always_inline]] static V join(__m256d low, __m256d high) {
         return _mm512_insertf64x4(_mm512_castpd256_pd512(low), high, 1);
     }
@@ -261,7 +307,6 @@ struct Simd {
 [[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
     const int* __restrict offsets = g.offsets;
     const int* __restrict upperBegin = g.upperBegin;
-    const int* __restrict pairBegin = g.pairBegin;
     const int* __restrict pairOf = g.pairOf;
     const std::uint8_t* __restrict alive = g.alive;
     const double* __restrict pairForce = g.pairForce;
@@ -273,9 +318,10 @@ struct Simd {
             if (alive[b])
                 sum = _mm256_sub_pd(sum,
                                     _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
-        for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
+        for (int b = upperBegin[i]; b < offsets[i + 1]; ++b)
             if (alive[b])
-                sum = _mm256_add_pd(sum, _mm256_loadu_pd(pairForce + 4 * (unsigned(u) & mask)));
+                sum = _mm256_add_pd(sum,
+                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
         double lanes[4];
         _mm256_storeu_pd(lanes, sum);
         force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];

@@ -56,8 +56,7 @@ double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, 
 struct PairGather {
     const int* offsets = nullptr;
     const int* upperBegin = nullptr;
-    const int* pairBegin = nullptr;
-    const int* pairOf = nullptr;
+    const int* pairOf = nullptr;  ///< per directed bond: its pair u
     const std::uint8_t* alive = nullptr;
     const double* pairForce = nullptr;  ///< LinearPairOutput::force: pair u at slot u & slotMask
     double* force = nullptr;            ///< x y z per particle

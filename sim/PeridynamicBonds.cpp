@@ -40,33 +40,70 @@ bool PeridynamicBonds::vectorised() const {
     return law_.kind == BondLawKind::PowerLaw && !ownLaws() && (n == 2.0 || n == 3.0 || n == 4.0);
 }
 
+// Tiles: the k-th upper pair of the kTile particles of a tile lie side by side (pair
+// tileBegin_[t] + kTile k + lane), so that on a regular lattice the kernels load eight pairs'
+// ends and theta as runs of consecutive particles. A lane with fewer pairs than its tile's most
+// repeats one of the tile's pairs (a pad: computed, never summed, never proposed).
 void PeridynamicBonds::setUpPairArrays() {
     if (!vectorised()) return;
+    const int n = bonds_.particleCount();
     reach_ = 0;
-    for (int i = 0; i < bonds_.particleCount(); ++i)
+    for (int i = 0; i < n; ++i)
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b)
             reach_ = std::max(reach_, i - bonds_.partners[b]);
-    // A ring holds the pairs of the reach_ particles before a block and the block's own.
-    const int n = bonds_.particleCount();
-    int window = 8;
-    for (int i = 0; i < n; ++i)
-        window = std::max(
-            window, pairs_.pairBegin[std::min(n, i + reach_ + kFusedBlock)] - pairs_.pairBegin[i]);
+    const int tiles = (n + kTile - 1) / kTile;
+    const auto uppers = [&](int i) {
+        return i < n ? bonds_.offsets[i + 1] - pairs_.upperBegin[i] : 0;
+    };
+    tileBegin_.assign(tiles + 1, 0);
+    for (int t = 0; t < tiles; ++t) {
+        int most = 0;
+        for (int lane = 0; lane < kTile; ++lane) most = std::max(most, uppers(kTile * t + lane));
+        tileBegin_[t + 1] = tileBegin_[t] + kTile * most;
+    }
+    const int pairs = tileBegin_[tiles];
+    pairFirst_.resize(pairs), pairSecond_.resize(pairs), pairUpper_.resize(pairs);
+    pairTwin_.resize(pairs), pairPad_.assign(pairs, 1);
+    pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
+    slotOf_.assign(bonds_.directedCount(), -1);
+    const auto place = [&](int u, int i, int b) {
+        pairFirst_[u] = i, pairSecond_[u] = bonds_.partners[b];
+        pairUpper_[u] = b, pairTwin_[u] = pairs_.twin[pairs_.pairOf[b]];
+        pairRest_[u] = bonds_.restLength[b], pairScale_[u] = bondScale_[b];
+        pairLimit_[u] = criticalStretch_;
+        if (!stretchFactor_.empty()) pairLimit_[u] *= stretchFactor_[b];
+    };
+    for (int t = 0; t < tiles; ++t) {
+        const int most = (tileBegin_[t + 1] - tileBegin_[t]) / kTile;
+        int spare = -1, spareOf = -1;  // a real pair of the tile, for lanes without one
+        for (int lane = 0; lane < kTile; ++lane)
+            if (uppers(kTile * t + lane) > 0) {
+                spareOf = kTile * t + lane, spare = pairs_.upperBegin[spareOf];
+                break;
+            }
+        for (int lane = 0; lane < kTile; ++lane) {
+            const int i = kTile * t + lane, count = uppers(i);
+            for (int k = 0; k < most; ++k) {
+                const int u = tileBegin_[t] + kTile * k + lane;
+                if (k < count) {
+                    const int b = pairs_.upperBegin[i] + k;
+                    place(u, i, b);
+                    pairPad_[u] = 0, slotOf_[b] = slotOf_[pairs_.twin[pairs_.pairOf[b]]] = u;
+                } else if (count > 0) {
+                    place(u, i, pairs_.upperBegin[i] + count - 1);
+                } else {
+                    place(u, spareOf, spare);
+                }
+            }
+        }
+    }
+    // A ring holds the pairs of the tiles from reach_ particles before a block to its end.
+    int window = kTile;
+    for (int p = 0; p < n; p += kTile)
+        window = std::max(window, pairsBefore(std::min(n, p + kFusedBlock)) -
+                                      pairsBefore(tileStart(std::max(0, p - reach_))));
     ringPairs_ = 1;
     while (ringPairs_ < window) ringPairs_ *= 2;
-    const int pairs = pairs_.pairCount();
-    pairFirst_.resize(pairs), pairSecond_.resize(pairs);
-    pairRest_.resize(pairs), pairScale_.resize(pairs), pairLimit_.resize(pairs);
-    pairUpper_.resize(pairs);
-    for (int i = 0; i < bonds_.particleCount(); ++i)
-        for (int b = pairs_.upperBegin[i]; b < bonds_.offsets[i + 1]; ++b) {
-            const int u = pairs_.pairOf[b];
-            pairFirst_[u] = i, pairSecond_[u] = bonds_.partners[b];
-            pairRest_[u] = bonds_.restLength[b], pairScale_[u] = bondScale_[b];
-            pairUpper_[u] = b;
-            pairLimit_[u] = criticalStretch_;
-            if (!stretchFactor_.empty()) pairLimit_[u] *= stretchFactor_[b];
-        }
 }
 
 std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
@@ -342,7 +379,7 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.update = update;
     in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
-    in.twin = pairs_.twin.data();
+    in.twin = pairTwin_.data();
     in.plastic = plastic;
     return in;
 }
@@ -355,13 +392,12 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     force.resize(n);
     const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
     work.slots.resize(4 * std::size_t(ringPairs_) * teams);
-    if (kBreak) work.over.resize(pairs_.pairCount());
+    if (kBreak) work.over.resize(pairFirst_.size());
     const LinearPairInput in =
         pairInput(s, kUpdateBonds, kBreak,
                   kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data()));
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
-    const int* pairBegin = pairs_.pairBegin.data();
     double stiffest = 1.0;
     // Each thread takes a run of particles and, block by block, computes their pairs into its
     // own ring of slots and at once sums them into the block's particles, while the slots are
@@ -369,17 +405,19 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     // at most reach_ particles: each thread first computes the pairs of the reach_ particles
     // before its run (read-only, before the barrier, so before any owner moves the histories
     // on). Every slot holds the bits the owner computes, and each sum is in the gather's order:
-    // the same bits for any thread count.
+    // the same bits for any thread count. Runs and blocks start at a tile's first particle.
 #pragma omp parallel if (n >= kParallelThreshold) reduction(max : stiffest)
     {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
         const std::int64_t span = slab_.end - slab_.ghostBegin;
-        const int from = slab_.ghostBegin + int(span * t / threads);
-        const int to = slab_.ghostBegin + int(span * (t + 1) / threads);
+        const int from = tileStart(slab_.ghostBegin + int(span * t / threads));
+        const int to = t + 1 == threads
+                           ? slab_.end
+                           : tileStart(slab_.ghostBegin + int(span * (t + 1) / threads));
         double* ring = work.slots.data() + 4 * std::size_t(ringPairs_) * t;
         const auto compute = [&](const LinearPairInput& input, int p, int q) {
             double most = 1.0;
-            for (int u = pairBegin[p], end = pairBegin[q]; u < end;) {  // split where it wraps
+            for (int u = pairsBefore(p), end = pairsBefore(q); u < end;) {  // split at the wrap
                 const int base = u - int(unsigned(u) & (ringPairs_ - 1));
                 const int stop = std::min(end, base + ringPairs_);
                 most = std::max(most,
@@ -388,11 +426,15 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             }
             return most;
         };
-        compute(halo, std::max(slab_.ghostBegin, from - reach_), from);
+        compute(halo, tileStart(std::max(slab_.ghostBegin, from - reach_)), from);
 #pragma omp barrier
-        PairGather gather{bonds_.offsets.data(), pairs_.upperBegin.data(),    pairBegin,
-                          pairs_.pairOf.data(),  damage_->bondAlive().data(), ring,
-                          force.data()->data(),  unsigned(ringPairs_ - 1)};
+        PairGather gather{bonds_.offsets.data(),
+                          pairs_.upperBegin.data(),
+                          slotOf_.data(),
+                          damage_->bondAlive().data(),
+                          ring,
+                          force.data()->data(),
+                          unsigned(ringPairs_ - 1)};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
             stiffest = std::max(stiffest, compute(in, p, q));
@@ -403,21 +445,22 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     updates.stiffest = stiffest;
 }
 
-// The pairs past their limit among this process's own particles' upper copies: both copies
-// proposed, in pair order.
+// The pairs past their limit among this process's own particles' upper copies (not the pads):
+// both copies proposed.
 int PeridynamicBonds::proposeBreaks(const std::vector<std::uint8_t>& over,
                                     std::uint8_t* proposed) const {
     const std::uint8_t* alive = damage_->bondAlive().data();
     int breaking = 0;
-    const int end = pairs_.pairBegin[slab_.end];
-    for (int u = pairs_.pairBegin[slab_.begin]; u < end; ++u) {
+    const int end = pairsBefore(slab_.end);
+    for (int u = pairsBefore(tileStart(slab_.begin)); u < end; ++u) {
         std::uint64_t eight = 0;  // eight pairs at once where none is past its limit
         if (u + 8 <= end && (std::memcpy(&eight, &over[u], 8), eight == 0)) {
             u += 7;
             continue;
         }
-        if (over[u] && alive[pairs_.twin[u]]) {
-            proposed[pairs_.twin[u]] = 1;
+        const bool own = pairFirst_[u] >= slab_.begin && pairFirst_[u] < slab_.end;
+        if (over[u] && !pairPad_[u] && own && alive[pairTwin_[u]]) {
+            proposed[pairTwin_[u]] = 1;
             proposed[pairUpper_[u]] = 1;
             breaking += 2;
         }

@@ -123,13 +123,21 @@ private:
 
     const BondFamilies& bonds_;
     BondPairs pairs_;  ///< each bond once, for the force loop
-    /// Per pair, for the linear law's vectorised pass: its ends, rest length, bond scale and
-    /// critical stretch (sim/PairKernels.h).
-    std::vector<int> pairFirst_, pairSecond_, pairUpper_;
+    /// The vectorised pass's pairs, in tiles of kTile particles (setUpPairArrays): per pair its
+    /// ends, upper and lower copies, rest length, bond scale, critical stretch and whether it
+    /// is a pad; per directed bond, its pair there.
+    static constexpr int kTile = 8;
+    std::vector<int> tileBegin_;  ///< per tile, and one past the last: its first pair
+    std::vector<int> pairFirst_, pairSecond_, pairUpper_, pairTwin_, slotOf_;
+    std::vector<std::uint8_t> pairPad_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
+    /// The first pair of the tile starting at particle p (a tile's first, or the particle count).
+    int pairsBefore(int p) const { return tileBegin_[(p + kTile - 1) / kTile]; }
+    /// p rounded down to its tile's first particle.
+    static int tileStart(int p) { return p - p % kTile; }
     int reach_ = 0;  ///< the largest i - j over bonds i -> j: how far back a lower copy lies
     int ringPairs_ =
-        1;  ///< slots in each thread's ring: a power of 2 >= any reach_ + block's pairs
+        1;  ///< slots in each thread's ring: a power of 2 >= the pairs a block's sums need
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     Material material_;

@@ -223,6 +223,41 @@ TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {
     }
 }
 
+// advance() breaks the bonds past their limit, both copies, each once: the pairs are computed in
+// tiles of eight particles whose short lanes repeat a pair (sim/PeridynamicBonds.h), and a
+// repeat is never proposed. A 1 x 0.5 m sheet on 1 and 3 threads, some bonds already dead.
+TEST(PairLoop, AdvanceBreaksEachBondPastItsLimitOnce) {
+    MembraneParams p = SmallSheet::params(BondLawKind::Linear);
+    p.sheet.size = {1.0, 0.5};
+    p.material.fractureEnergy = 0.02;
+    const int before = omp_get_max_threads();
+    for (const int threads : {1, 3}) {
+        omp_set_num_threads(threads);
+        SmallSheet sheet(p);
+        auto& [params, lattice, bonds, volumes, solver, damage] = sheet;
+        for (int b = 0; b < int(bonds.directedCount()); b += 31) damage.breakBond(b);
+        const int n = int(lattice.positions.size());
+        std::vector<Eigen::Vector3d> x = lattice.positions, v(n, Eigen::Vector3d::Zero());
+        const double etaC = solver.criticalStretch();
+        for (int i = 0; i < n; ++i)
+            for (int a = 0; a < 2; ++a)
+                x[i][a] += 1.5 * etaC * p.sheet.dx * (2.0 * uniformFromHash(5, 3 * i + a) - 1.0);
+        std::vector<std::uint8_t> expected = damage.bondAlive();
+        std::size_t breaking = 0;  // directed copies
+        for (int i = 0; i < n; ++i)
+            for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+                const double eta = (x[bonds.partners[b]] - x[i]).norm() / bonds.restLength[b] - 1.0;
+                if (expected[b] && eta > etaC) expected[b] = 0, ++breaking;
+            }
+        ASSERT_GT(breaking, 1000u) << "the test breaks bonds";
+        const std::size_t broken = damage.brokenBondCount();
+        solver.advanceAt(x, v, 1e-5);
+        EXPECT_EQ(damage.bondAlive(), expected) << threads << " threads";
+        EXPECT_EQ(damage.brokenBondCount(), broken + breaking / 2) << threads << " threads";
+    }
+    omp_set_num_threads(before);
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                          ::testing::Values(Case{BondLawKind::Linear, false, false},
                                            Case{BondLawKind::Linear, true, true},

@@ -55,7 +55,7 @@ void DamageState::breakBond(int b) {
     if (!bondAlive_[b]) return;
     bondAlive_[b] = 0;
     if (mirror_[b] >= 0) bondAlive_[mirror_[b]] = 0;
-    ++brokenBonds_;
+    ++brokenBonds_, ++version_;
     if (bondEdge_[b] >= 0) killEdge(bondEdge_[b]);
 }
 

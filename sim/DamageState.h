@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "sim/Bonds.h"
@@ -59,6 +60,9 @@ public:
     /// Per rest triangle: 1 while it is alive and all three edges are intact.
     const std::vector<std::uint8_t>& keptTriangles() const { return kept_; }
     std::size_t brokenBondCount() const { return brokenBonds_; }
+    /// Moves on whenever bondAlive() changes (a break, a loaded state): a copy made at one
+    /// version is current while it holds.
+    std::uint64_t version() const { return version_; }
     std::size_t removedTriangleCount() const { return removedTriangles_; }
 
     // The operations.
@@ -84,6 +88,7 @@ public:
     static void visitState(Self& s, Archive& a) {
         a(s.bondAlive_), a(s.edgeAlive_), a(s.triangleAlive_), a(s.kept_), a(s.strength_);
         a(s.brokenBonds_), a(s.removedTriangles_);
+        if constexpr (!std::is_const_v<Self>) ++s.version_;  // loading
     }
 
 private:
@@ -95,6 +100,7 @@ private:
     std::vector<std::uint8_t> bondAlive_, proposed_, edgeAlive_, triangleAlive_, kept_;
     std::vector<double> strength_;
     std::size_t brokenBonds_ = 0, removedTriangles_ = 0;
+    std::uint64_t version_ = 0;
 };
 
 }  // namespace rend::sim

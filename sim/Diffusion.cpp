@@ -27,19 +27,20 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
     // particles stays equal and opposite, so the heat, the sum of rho C V theta, is kept).
     const std::vector<double> density =
         materialFactors(MappedProperty::Density, params.materialMaps, rest);
-    rate_.resize(bonds.directedCount());
+    std::vector<double> rate(bonds.directedCount());
     double worst = 0.0;
     for (int i = 0; i < n; ++i) {
         const double rhoC = m.density * density[i] * m.capacity;
         double total = 0.0;
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
             const double xi = bonds.restLength[b];
-            rate_[b] = K_ * bonds.weight[b] * volumes[bonds.partners[b]] / (rhoC * xi * xi);
-            total += rate_[b];
+            rate[b] = K_ * bonds.weight[b] * volumes[bonds.partners[b]] / (rhoC * xi * xi);
+            total += rate[b];
         }
         worst = std::max(worst, total);
     }
     stableDt_ = worst > 0.0 ? 1.0 / worst : std::numeric_limits<double>::infinity();
+    tiles_ = DiffusionTiles::build(bonds, rate);
     const SheetParams& sheet = params.sheet;
     const bool seeded = sheet.seedSpacing > 0.0 && sheet.seedSpacing != sheet.dx;
     const std::optional<Lattice> seeds =
@@ -107,26 +108,26 @@ std::vector<double> Diffusion::initialTheta() const {
     return theta;
 }
 
-void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
-                     std::span<const std::uint8_t> alive, double t, double dt) {
+void Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
+                     std::uint64_t aliveVersion, double t, double dt) {
     const int n = int(theta.size());
     scratch_.resize(n);
+    tiles_.refresh(alive.data(), aliveVersion);
     const int first = domain_ ? domain_->slab().begin : 0, last = domain_ ? domain_->slab().end : n;
-    // Local restrict pointers: through the members, each store to scratch_ would reload them.
-    const int* __restrict offsets = bonds.offsets.data();
-    const int* __restrict partners = bonds.partners.data();
-    const std::uint8_t* __restrict living = alive.data();
-    const double* __restrict rate = rate_.data();
-    const double* __restrict now = theta.data();
-    double* __restrict next = scratch_.data();
+    // The whole tiles of [first, last) eight at a time, the few particles at its ends alone.
+    constexpr int kTile = DiffusionTiles::kTile, kChunk = 64;
+    const int firstTile = (first + kTile - 1) / kTile, lastTile = std::max(firstTile, last / kTile);
+    const int chunks = (lastTile - firstTile + kChunk - 1) / kChunk;
+    const double* now = theta.data();
+    double* next = scratch_.data();
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = first; i < last; ++i) {
-        double flux = 0.0;
-        const double own = now[i];
-        for (int b = offsets[i]; b < offsets[i + 1]; ++b)
-            if (living[b]) flux += rate[b] * (now[partners[b]] - own);
-        next[i] = own + dt * flux;
-    }
+    for (int c = 0; c < chunks; ++c)
+        diffuseTiles(tiles_, now, next, dt, firstTile + c * kChunk,
+                     std::min(lastTile, firstTile + (c + 1) * kChunk));
+    for (int i = first; i < std::min(last, kTile * firstTile); ++i)
+        diffuseParticle(tiles_, now, next, dt, i);
+    for (int i = std::max(first, kTile * lastTile); i < last; ++i)
+        diffuseParticle(tiles_, now, next, dt, i);
     theta.swap(scratch_);
     for (const Spot& spot : spots_)  // serial, in a fixed order: identical for any thread count
         if (t >= spot.start && t < spot.end)
@@ -135,12 +136,12 @@ void Diffusion::step(std::vector<double>& theta, const BondFamilies& bonds,
     if (domain_) domain_->exchange(theta.data(), 1);
 }
 
-void Diffusion::advance(std::vector<double>& theta, const BondFamilies& bonds,
-                        std::span<const std::uint8_t> alive, double t, double dt) {
+void Diffusion::advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
+                        std::uint64_t aliveVersion, double t, double dt) {
     // 0.9 of the Gershgorin bound keeps a margin for rounding.
     const int substeps = std::max(1, int(std::ceil(dt / (0.9 * stableDt_))));
     const double h = dt / substeps;
-    for (int k = 0; k < substeps; ++k) step(theta, bonds, alive, t + k * h, h);
+    for (int k = 0; k < substeps; ++k) step(theta, alive, aliveVersion, t + k * h, h);
 }
 
 }  // namespace rend::sim

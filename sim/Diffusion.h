@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sim/Bonds.h"
+#include "sim/DiffusionKernels.h"
 #include "sim/Domain.h"
 #include "sim/Lattice.h"
 #include "sim/Params.h"
@@ -40,8 +41,10 @@ public:
     std::vector<double> initialTheta() const;
 
     /// Advances theta from t to t + dt, sub-stepping as the stability bound requires.
-    void advance(std::vector<double>& theta, const BondFamilies& bonds,
-                 std::span<const std::uint8_t> alive, double t, double dt);
+    /// `alive` per directed bond of the bonds it was built on; `aliveVersion` changes whenever
+    /// it does (DamageState::version()).
+    void advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
+                 std::uint64_t aliveVersion, double t, double dt);
 
     std::size_t spotCount() const { return spots_.size(); }
 
@@ -63,14 +66,15 @@ private:
     };
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
-    void step(std::vector<double>& theta, const BondFamilies& bonds,
-              std::span<const std::uint8_t> alive, double t, double dt);
+    void step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
+              std::uint64_t aliveVersion, double t, double dt);
 
     double K_ = 0.0;
     double stableDt_ = 0.0;
     double initial_ = 0.0;
     int particles_ = 0;
-    std::vector<double> rate_;  ///< per bond: K W0 V_j / (rho C |xi|^2) [1/s]
+    /// Per bond, K W0 V_j / (rho C |xi|^2) [1/s], in tiles of eight particles.
+    DiffusionTiles tiles_;
     std::vector<Spot> spots_;
     std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value
     std::vector<double> scratch_;

@@ -346,7 +346,7 @@ void Membrane::step() {
         forcesCurrent_ = false;
     }
     if (diffusion_) {
-        diffusion_->advance(theta_, bonds_, damageState_.bondAlive(), time_,
+        diffusion_->advance(theta_, damageState_.bondAlive(), damageState_.version(), time_,
                             dt_);  // theta^n -> theta^n+1 (and its ghosts, decomposed)
         forcesCurrent_ = false;
     }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "sim/Parallel.h"
+#include "sim/StepKernels.h"
 #include "sim/TimeStep.h"
 
 namespace rend::sim {
@@ -91,63 +92,22 @@ BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
     floor_ = 0.5 * totalMass * std::pow(1e-3 * waveSpeed, 2);
 }
 
-// One block's sums. Only v is checked for finiteness: x moves by dt v from a finite start, so a
-// non-finite x has had a non-finite v first (or one over the limit), and skipping it halves the
-// memory the pass reads. Four partial sums, of every fourth particle, added in a fixed order:
-// four short dependency chains instead of one long one, and the same bits for any thread count.
-// The sums live in locals, not in `out`: a store to a double the compiler cannot prove apart
-// from the spans would put a store and a reload on every particle's chain.
+// One block's sums (sim/StepKernels.h: eight particles at a time with AVX-512). Only v is checked
+// for finiteness: x moves by dt v from a finite start, so a non-finite x has had a non-finite v
+// first (or one over the limit), and skipping it halves the memory the pass reads. The blocks
+// are fixed, and each is summed in a fixed order: the same bits for any thread count.
 void BlowUpGuard::sampleBlock(const State& s, int begin, int end, Sample& out) const {
-    const double limitSquared = speedLimit_ * speedLimit_;
-    const Eigen::Vector3d gravity = gravity_;
-    const bool hasGravity = hasGravity_;
-    struct Part {
-        double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0, maxAbsTheta = 0.0;
-    };
-    double maxSpeedSquared = 0.0;
-    int fastest = -1, firstBad = -1;
-    const auto visit = [&](int i, Part& p) {
-        const double speedSquared = s.v[i].squaredNorm();
-        if (!(speedSquared <= limitSquared) && firstBad < 0) firstBad = i;
-        const std::int16_t c = s.constraint[i];
-        if (c != kFree) {
-            if (c >= 0) p.boundaryPower += std::abs(s.force[i].dot(s.v[i]));
-            return;
-        }
-        p.kinetic += 0.5 * s.mass[i] * speedSquared;
-        if (hasGravity) p.gravityPower += s.mass[i] * std::abs(gravity.dot(s.v[i]));
-        if (speedSquared > maxSpeedSquared) {
-            maxSpeedSquared = speedSquared;
-            fastest = i;
-        }
-    };
-    // The largest |theta| does not depend on the order; NaN is skipped here (std::max keeps
-    // its first argument) and caught as firstBad.
-    const bool theta = !s.theta.empty();
-    const auto visitTheta = [&](int i, Part& p) {
-        if (!std::isfinite(s.theta[i]) && (firstBad < 0 || i < firstBad)) firstBad = i;
-        p.maxAbsTheta = std::max(p.maxAbsTheta, std::abs(s.theta[i]));
-    };
-    Part p0, p1, p2, p3;  // locals, so that each chain stays in registers
-    int i = begin;
-    for (; i + 4 <= end; i += 4) visit(i, p0), visit(i + 1, p1), visit(i + 2, p2), visit(i + 3, p3);
-    for (; i < end; ++i) visit(i, p0);
-    if (theta) {
-        for (i = begin; i + 4 <= end; i += 4)
-            visitTheta(i, p0), visitTheta(i + 1, p1), visitTheta(i + 2, p2), visitTheta(i + 3, p3);
-        for (; i < end; ++i) visitTheta(i, p0);
-    }
-    const auto total = [&](double Part::*field) {
-        return (p0.*field + p1.*field) + (p2.*field + p3.*field);
-    };
-    out = {total(&Part::kinetic),
-           total(&Part::boundaryPower),
-           total(&Part::gravityPower),
-           maxSpeedSquared,
-           std::max(std::max(p0.maxAbsTheta, p1.maxAbsTheta),
-                    std::max(p2.maxAbsTheta, p3.maxAbsTheta)),
-           fastest,
-           firstBad};
+    GuardInput in{s.v.data()->data(),
+                  s.force.empty() ? nullptr : s.force.data()->data(),
+                  s.mass.data(),
+                  s.constraint.data(),
+                  s.theta.empty() ? nullptr : s.theta.data(),
+                  speedLimit_ * speedLimit_,
+                  {gravity_.x(), gravity_.y(), gravity_.z()},
+                  hasGravity_};
+    const GuardSums r = guardSums(in, begin, end);
+    out = {r.kinetic,     r.boundaryPower, r.gravityPower, r.maxSpeedSquared,
+           r.maxAbsTheta, r.fastest,       r.firstBad};
 }
 
 BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "sim/BondLaw.h"
+#include "sim/SimdRuns.h"
 #include "sim/StepKernels.h"
 
 namespace rend::sim {
@@ -263,18 +264,9 @@ struct Simd {
                                              _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
         return unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi32(at, run))) == 0xffffffffu;
     }
-    [[gnu::always_inline]] static V pick(V lo, V hi, __m512i from) {
-        return _mm512_permutex2var_pd(lo, from, hi);
-    }
-    /// Eight consecutive particles' x, y and z from p: three loads, six permutes.
+    /// Eight consecutive particles' x, y and z from p (sim/SimdRuns.h).
     [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {
-        const V a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);
-        x = pick(pick(a, b, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0)), c,
-                 _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13));
-        y = pick(pick(a, b, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0)), c,
-                 _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14));
-        z = pick(pick(a, b, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0)), c,
-                 _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
+        loadRun8(p, x, y, z);
     }
     [[gnu::always_inline]] static V join(__m256d low, __m256d high) {
         return _mm512_insertf64x4(_mm512_castpd256_pd512(low), high, 1);

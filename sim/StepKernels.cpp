@@ -3,9 +3,13 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <string_view>
+
+#include "sim/SimdRuns.h"
 
 namespace rend::sim {
 namespace {
@@ -35,6 +39,59 @@ inline bool allFree(const std::int16_t* constraint, int count) {
         if (tags != ~std::uint64_t(0)) return false;
     }
     return true;
+}
+
+/// The guard's sums of one chain (sim/BlowUpGuard.h).
+struct GuardPart {
+    double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0, maxAbsTheta = 0.0;
+};
+
+/// Particle i's speed check, its share of the sums and whether it is the fastest so far.
+inline void guardVisit(const GuardInput& g, int i, GuardPart& p, GuardSums& s) {
+    const double* v = g.v + 3 * i;
+    const double speedSquared = (v[0] * v[0] + v[1] * v[1]) + v[2] * v[2];
+    if (!(speedSquared <= g.limitSquared) && s.firstBad < 0) s.firstBad = i;
+    const std::int16_t c = g.constraint[i];
+    if (c != kFree) {
+        const double* f = g.force + 3 * i;
+        if (c >= 0) p.boundaryPower += std::abs((f[0] * v[0] + f[1] * v[1]) + f[2] * v[2]);
+        return;
+    }
+    p.kinetic += 0.5 * g.mass[i] * speedSquared;
+    const double* a = g.gravity;
+    if (g.hasGravity)
+        p.gravityPower += g.mass[i] * std::abs((a[0] * v[0] + a[1] * v[1]) + a[2] * v[2]);
+    if (speedSquared > s.maxSpeedSquared) s.maxSpeedSquared = speedSquared, s.fastest = i;
+}
+
+/// The largest |theta| skips NaN (std::max keeps its first argument); NaN and inf are bad.
+inline void guardVisitTheta(const GuardInput& g, int i, GuardPart& p, GuardSums& s) {
+    if (!std::isfinite(g.theta[i]) && (s.firstBad < 0 || i < s.firstBad)) s.firstBad = i;
+    p.maxAbsTheta = std::max(p.maxAbsTheta, std::abs(g.theta[i]));
+}
+
+/// Four chains, of every fourth particle, added in a fixed order.
+GuardSums guardScalar(const GuardInput& g, int begin, int end) {
+    GuardSums s;
+    GuardPart p[4];
+    int i = begin;
+    for (; i + 4 <= end; i += 4)
+        for (int k = 0; k < 4; ++k) guardVisit(g, i + k, p[k], s);
+    for (; i < end; ++i) guardVisit(g, i, p[0], s);
+    if (g.theta) {
+        for (i = begin; i + 4 <= end; i += 4)
+            for (int k = 0; k < 4; ++k) guardVisitTheta(g, i + k, p[k], s);
+        for (; i < end; ++i) guardVisitTheta(g, i, p[0], s);
+    }
+    const auto total = [&](double GuardPart::*field) {
+        return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
+    };
+    s.kinetic = total(&GuardPart::kinetic);
+    s.boundaryPower = total(&GuardPart::boundaryPower);
+    s.gravityPower = total(&GuardPart::gravityPower);
+    s.maxAbsTheta = std::max(std::max(p[0].maxAbsTheta, p[1].maxAbsTheta),
+                             std::max(p[2].maxAbsTheta, p[3].maxAbsTheta));
+    return s;
 }
 
 #if defined(__x86_64__)
@@ -117,9 +174,89 @@ inline bool allFree(const std::int16_t* constraint, int count) {
     return i;
 }
 
+/// Eight lanes' sums, added pairwise in lane order.
+[[gnu::target("avx2,avx512f")]] inline double laneSum(__m512d a) {
+    double l[8];
+    _mm512_storeu_pd(l, a);
+    return ((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]));
+}
+
+// Eight free particles at a time, one chain per lane; the others, and the tail, one at a time
+// in a chain of their own. The lanes' largest speeds and their indices meet at the end, the
+// lowest index winning a tie.
+[[gnu::target("avx2,avx512f")]] GuardSums guardAvx512(const GuardInput& g, int begin, int end) {
+    GuardSums s;
+    GuardPart p;
+    const __m512d half = _mm512_set1_pd(0.5), limit = _mm512_set1_pd(g.limitSquared);
+    const __m512d gx = _mm512_set1_pd(g.gravity[0]), gy = _mm512_set1_pd(g.gravity[1]);
+    const __m512d gz = _mm512_set1_pd(g.gravity[2]);
+    const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+    __m512d kinetic = _mm512_setzero_pd(), gravityPower = _mm512_setzero_pd();
+    __m512d best = _mm512_setzero_pd(), maxTheta = _mm512_setzero_pd();
+    __m512i bestAt = _mm512_set1_epi64(-1);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        if (!allFree(g.constraint + i, 8)) {
+            for (int q = i; q < i + 8; ++q) guardVisit(g, q, p, s);
+            continue;
+        }
+        __m512d vx, vy, vz;
+        loadRun8(g.v + 3 * i, vx, vy, vz);
+        const __m512d ss = _mm512_add_pd(
+            _mm512_add_pd(_mm512_mul_pd(vx, vx), _mm512_mul_pd(vy, vy)), _mm512_mul_pd(vz, vz));
+        const unsigned bad = _mm512_cmp_pd_mask(ss, limit, _CMP_NLE_UQ);
+        if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(bad);
+        const __m512d m = _mm512_loadu_pd(g.mass + i);
+        kinetic = _mm512_add_pd(kinetic, _mm512_mul_pd(_mm512_mul_pd(half, m), ss));
+        if (g.hasGravity) {
+            const __m512d along = _mm512_add_pd(
+                _mm512_add_pd(_mm512_mul_pd(gx, vx), _mm512_mul_pd(gy, vy)), _mm512_mul_pd(gz, vz));
+            gravityPower = _mm512_add_pd(gravityPower, _mm512_mul_pd(m, _mm512_abs_pd(along)));
+        }
+        const __mmask8 faster = _mm512_cmp_pd_mask(ss, best, _CMP_GT_OQ);
+        best = _mm512_mask_blend_pd(faster, best, ss);
+        bestAt =
+            _mm512_mask_blend_epi64(faster, bestAt, _mm512_add_epi64(_mm512_set1_epi64(i), iota));
+    }
+    for (; i < end; ++i) guardVisit(g, i, p, s);
+    if (g.theta) {
+        const __m512d finite = _mm512_set1_pd(std::numeric_limits<double>::max());
+        for (i = begin; i + 8 <= end; i += 8) {
+            const __m512d a = _mm512_abs_pd(_mm512_loadu_pd(g.theta + i));
+            const unsigned bad = _mm512_cmp_pd_mask(a, finite, _CMP_NLE_UQ);
+            const int at = i + __builtin_ctz(bad | 256u);
+            if (bad != 0 && (s.firstBad < 0 || at < s.firstBad)) s.firstBad = at;
+            maxTheta = _mm512_max_pd(a, maxTheta);  // a NaN lane keeps maxTheta
+        }
+        for (; i < end; ++i) guardVisitTheta(g, i, p, s);
+    }
+    s.kinetic = laneSum(kinetic) + p.kinetic;
+    s.gravityPower = laneSum(gravityPower) + p.gravityPower;
+    s.boundaryPower = p.boundaryPower;
+    double speeds[8], thetas[8];
+    std::int64_t at[8];
+    _mm512_storeu_pd(speeds, best), _mm512_storeu_pd(thetas, maxTheta);
+    _mm512_storeu_si512(at, bestAt);
+    s.maxAbsTheta = p.maxAbsTheta;
+    for (int l = 0; l < 8; ++l) {
+        s.maxAbsTheta = std::max(s.maxAbsTheta, thetas[l]);
+        const bool higher = speeds[l] > s.maxSpeedSquared;
+        const bool tie = speeds[l] == s.maxSpeedSquared && at[l] < s.fastest;
+        if (at[l] >= 0 && (higher || tie)) s.maxSpeedSquared = speeds[l], s.fastest = int(at[l]);
+    }
+    return s;
+}
+
 #endif
 
 }  // namespace
+
+GuardSums guardSums(const GuardInput& g, int begin, int end) {
+#if defined(__x86_64__)
+    if (simdWidth() == 8) return guardAvx512(g, begin, end);
+#endif
+    return guardScalar(g, begin, end);
+}
 
 int simdWidth() {
     static const int width = [] {

@@ -32,6 +32,31 @@ struct KickDrift {
 /// is not >= k.floor afterwards (NaN counts).
 bool kickDrift(const KickDrift& k, int begin, int end);
 
+/// What the blow-up guard (sim/BlowUpGuard.h) reads of a range of particles after a step.
+struct GuardInput {
+    const double* v = nullptr;  ///< x y z per particle
+    const double* force = nullptr;
+    const double* mass = nullptr;
+    const std::int16_t* constraint = nullptr;
+    const double* theta = nullptr;  ///< null: no diffusion
+    double limitSquared = 0.0;      ///< the speed limit, squared
+    double gravity[3] = {0.0, 0.0, 0.0};
+    bool hasGravity = false;
+};
+
+/// Its sums (BlowUpGuard::Sample's): in a fixed order for a given range and width, so the same
+/// for any thread count; the vector widths add in more chains than the scalar one.
+struct GuardSums {
+    double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0;
+    double maxSpeedSquared = 0.0, maxAbsTheta = 0.0;
+    int fastest = -1, firstBad = -1;
+};
+
+/// Particles [begin, end): the free particles' kinetic energy, |m g . v| and largest speed
+/// (the lowest index at it), the driven ones' |f . v|, the largest |theta|, and the lowest index
+/// whose speed is not within the limit or whose theta is not finite.
+GuardSums guardSums(const GuardInput& g, int begin, int end);
+
 /// Lanes of the vector kernels here and in sim/PairKernels.h: 8 with AVX-512, 4 with AVX2, 1
 /// without. REND_SIMD=avx2 or REND_SIMD=scalar in the environment caps it (to compare them; every
 /// width gives the same bits).

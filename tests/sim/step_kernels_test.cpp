@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -108,6 +110,66 @@ TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {
     KickDrift k = viewOf(p, boundary, 1e-4, 1e-4);
     k.floor = floor;
     EXPECT_TRUE(kickDrift(k, 0, int(p.x.size()))) << "a NaN height is not above the floor";
+}
+
+}  // namespace
+
+namespace {
+
+/// The guard's sums one particle at a time, in index order.
+GuardSums naiveGuard(const GuardInput& g, int n) {
+    GuardSums s;
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d v(g.v[3 * i], g.v[3 * i + 1], g.v[3 * i + 2]);
+        const double speed = v.squaredNorm();
+        const bool badTheta = g.theta && !std::isfinite(g.theta[i]);
+        if ((!(speed <= g.limitSquared) || badTheta) && s.firstBad < 0) s.firstBad = i;
+        if (g.theta && !std::isnan(g.theta[i]))  // inf counts, NaN is skipped
+            s.maxAbsTheta = std::max(s.maxAbsTheta, std::abs(g.theta[i]));
+        if (g.constraint[i] >= 0) {
+            const Eigen::Vector3d f(g.force[3 * i], g.force[3 * i + 1], g.force[3 * i + 2]);
+            s.boundaryPower += std::abs(f.dot(v));
+        }
+        if (g.constraint[i] != -1) continue;
+        s.kinetic += 0.5 * g.mass[i] * speed;
+        s.gravityPower += g.mass[i] * std::abs(Eigen::Vector3d(g.gravity).dot(v));
+        if (speed > s.maxSpeedSquared) s.maxSpeedSquared = speed, s.fastest = i;
+    }
+    return s;
+}
+
+// The guard's sums at this width (ctest's kernels.* run it at each): the largest speed, its
+// lowest index, the largest |theta| and the first bad index exactly, the sums to rounding; with
+// pinned and driven particles among the free, two free particles tied at the top speed, one too
+// fast, and an infinite and a NaN theta.
+TEST(GuardSums, MatchTheSumsOneParticleAtATime) {
+    for (const int n : {5, 64, 203}) {
+        Particles p = someParticles(n);
+        std::vector<double> theta(n);
+        for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(9, i) - 0.7;
+        const int top = n - 3, twin = n / 2;  // twin < top, both free
+        p.constraint[top] = p.constraint[twin] = -1;
+        p.v[top] = Eigen::Vector3d(3.0, 4.0, 0.0), p.v[twin] = Eigen::Vector3d(0.0, 4.0, 3.0);
+        GuardInput g{p.v.data()->data(), p.force.data()->data(),
+                     p.mass.data(),      p.constraint.data(),
+                     theta.data(),       30.0,
+                     {0.0, 0.0, -9.81},  true};
+        for (const int bad : {-1, 0, 1, 2}) {
+            if (bad == 1) p.v[n - 1] = Eigen::Vector3d(0.0, 0.0, 6.0);  // past the limit
+            if (bad == 2)
+                theta[1] = std::numeric_limits<double>::infinity(),
+                theta[n - 2] = std::numeric_limits<double>::quiet_NaN();
+            const GuardSums got = guardSums(g, 0, n), want = naiveGuard(g, n);
+            EXPECT_EQ(got.maxSpeedSquared, want.maxSpeedSquared) << n << " " << bad;
+            EXPECT_EQ(got.fastest, want.fastest) << n << " " << bad;
+            EXPECT_EQ(got.fastest, n >= 64 && bad < 1 ? twin : got.fastest);
+            EXPECT_EQ(got.firstBad, want.firstBad) << n << " " << bad;
+            EXPECT_EQ(got.maxAbsTheta, want.maxAbsTheta) << n << " " << bad;
+            EXPECT_NEAR(got.kinetic, want.kinetic, 1e-14 * want.kinetic);
+            EXPECT_NEAR(got.gravityPower, want.gravityPower, 1e-14 * want.gravityPower);
+            EXPECT_NEAR(got.boundaryPower, want.boundaryPower, 1e-14 * want.boundaryPower);
+        }
+    }
 }
 
 }  // namespace

@@ -1,0 +1,28 @@
+#pragma once
+// Eight consecutive particles' x, y and z (24 doubles, x0 y0 z0 x1 ... z7) as three AVX-512
+// vectors: three loads, six permutes. For the kernels compiled for AVX-512 (sim/PairKernels.cpp,
+// sim/StepKernels.cpp); include it only there.
+
+#include <immintrin.h>
+
+namespace rend::sim {
+
+[[gnu::always_inline, gnu::target("avx2,avx512f")]] inline __m512d pickLanes(__m512d low,
+                                                                             __m512d high,
+                                                                             __m512i from) {
+    return _mm512_permutex2var_pd(low, from, high);
+}
+
+[[gnu::always_inline, gnu::target("avx2,avx512f")]] inline void loadRun8(const double* p,
+                                                                         __m512d& x, __m512d& y,
+                                                                         __m512d& z) {
+    const __m512d a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);
+    x = pickLanes(pickLanes(a, b, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0)), c,
+                  _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13));
+    y = pickLanes(pickLanes(a, b, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0)), c,
+                  _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14));
+    z = pickLanes(pickLanes(a, b, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0)), c,
+                  _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
+}
+
+}  // namespace rend::sim

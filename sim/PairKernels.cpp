@@ -167,12 +167,6 @@ struct Simd {
         return _mm256_i32gather_pd(base, _mm_loadu_si128(reinterpret_cast<const __m128i*>(index)),
                                    8);
     }
-    /// Whether index[0..3] are consecutive: a run of particles.
-    [[gnu::always_inline]] static bool consecutive(const int* index) {
-        const __m128i at = _mm_loadu_si128(reinterpret_cast<const __m128i*>(index));
-        const __m128i run = _mm_add_epi32(_mm_set1_epi32(index[0]), _mm_setr_epi32(0, 1, 2, 3));
-        return _mm_movemask_epi8(_mm_cmpeq_epi32(at, run)) == 0xffff;
-    }
     /// The x, y and z of four consecutive particles from p (the first's x): three loads.
     [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {
         const V a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
@@ -257,12 +251,6 @@ struct Simd {
     [[gnu::always_inline]] static V gather(const double* base, const int* index) {
         return _mm512_i32gather_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)),
                                    base, 8);
-    }
-    [[gnu::always_inline]] static bool consecutive(const int* index) {
-        const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
-        const __m256i run = _mm256_add_epi32(_mm256_set1_epi32(index[0]),
-                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-        return unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi32(at, run))) == 0xffffffffu;
     }
     /// Eight consecutive particles' x, y and z from p (sim/SimdRuns.h).
     [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {

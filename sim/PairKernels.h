@@ -13,6 +13,9 @@
 
 namespace rend::sim {
 
+/// Pairs per tile of the pair order (sim/PeridynamicBonds.h): the kernels take whole tiles.
+inline constexpr int kPairTile = 8;
+
 struct LinearPairInput {
     const int* first = nullptr;   ///< per pair: the smaller index i
     const int* second = nullptr;  ///< per pair: j
@@ -37,6 +40,14 @@ struct LinearPairInput {
     const int* upper = nullptr;           ///< per pair: its upper copy
     const int* twin = nullptr;            ///< per pair: its lower copy
     PlasticState* plastic = nullptr;      ///< per directed bond (elastoplastic)
+    /// Per kPairTile pairs from a multiple of it (a vector, or two): where their ends are runs
+    /// of consecutive particles, the first of each run (else -1); where their rest lengths,
+    /// bond scales and limits are each one value, its class in the tables (else -1). Such
+    /// vectors read none of the per-pair arrays above but upper and twin.
+    const int* runFirst = nullptr;
+    const int* runSecond = nullptr;
+    const int* uniform = nullptr;
+    const double *classRest = nullptr, *classScale = nullptr, *classLimit = nullptr;
 };
 
 struct LinearPairOutput {

@@ -3,10 +3,13 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "sim/Fracture.h"
@@ -15,6 +18,8 @@
 #include "sim/SolverRegistry.h"
 
 namespace rend::sim {
+
+static_assert(PeridynamicBonds::kTile == kPairTile);
 
 PeridynamicBonds::PeridynamicBonds(const MembraneParams& params, const Lattice& lattice,
                                    const BondFamilies& bonds, std::span<const Eigen::Vector3d> rest,
@@ -97,6 +102,7 @@ void PeridynamicBonds::setUpPairArrays() {
             }
         }
     }
+    setUpPairRows();
     // A ring holds the pairs of the tiles from reach_ particles before a block to its end.
     int window = kTile;
     for (int p = 0; p < n; p += kTile)
@@ -104,6 +110,39 @@ void PeridynamicBonds::setUpPairArrays() {
                                       pairsBefore(tileStart(std::max(0, p - reach_))));
     ringPairs_ = 1;
     while (ringPairs_ < window) ringPairs_ *= 2;
+}
+
+// Per row of a tile (its particles' k-th pairs, side by side): whether its ends are two runs of
+// consecutive particles, and whether its rest lengths, scales and limits are one value each, to
+// the bit (then the kernels read them once, from the classes' tables). On a regular lattice
+// almost every row is both, and the per-pair arrays stay in memory unread.
+void PeridynamicBonds::setUpPairRows() {
+    const int rows = int(pairFirst_.size()) / kTile;
+    rowRunFirst_.assign(rows, -1), rowRunSecond_.assign(rows, -1), rowClass_.assign(rows, -1);
+    classRest_.clear(), classScale_.clear(), classLimit_.clear();
+    const auto bitsOf = [&](int u) {
+        return std::array<std::uint64_t, 3>{std::bit_cast<std::uint64_t>(pairRest_[u]),
+                                            std::bit_cast<std::uint64_t>(pairScale_[u]),
+                                            std::bit_cast<std::uint64_t>(pairLimit_[u])};
+    };
+    std::map<std::array<std::uint64_t, 3>, int> classes;
+    for (int row = 0; row < rows; ++row) {
+        const int u = kTile * row;
+        bool run = true, same = true;
+        for (int k = 1; k < kTile; ++k) {
+            run = run && pairFirst_[u + k] == pairFirst_[u] + k &&
+                  pairSecond_[u + k] == pairSecond_[u] + k;
+            same = same && bitsOf(u + k) == bitsOf(u);
+        }
+        if (run) rowRunFirst_[row] = pairFirst_[u], rowRunSecond_[row] = pairSecond_[u];
+        if (!same) continue;
+        const auto [at, added] = classes.try_emplace(bitsOf(u), int(classRest_.size()));
+        if (added) {
+            classRest_.push_back(pairRest_[u]), classScale_.push_back(pairScale_[u]);
+            classLimit_.push_back(pairLimit_[u]);
+        }
+        rowClass_[row] = at->second;
+    }
 }
 
 std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
@@ -381,6 +420,10 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
     in.twin = pairTwin_.data();
     in.plastic = plastic;
+    in.runFirst = rowRunFirst_.data(), in.runSecond = rowRunSecond_.data();
+    in.uniform = rowClass_.data();
+    in.classRest = classRest_.data(), in.classScale = classScale_.data();
+    in.classLimit = classLimit_.data();
     return in;
 }
 

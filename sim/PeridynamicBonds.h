@@ -28,6 +28,8 @@ struct LinearPairInput;  // sim/PairKernels.h
 
 class PeridynamicBonds final : public Solver {
 public:
+    /// Particles per tile of the vectorised pass's pair order (sim/PairKernels.h's kPairTile).
+    static constexpr int kTile = 8;
     /// `bonds` is the Membrane's (kept by reference), `rest` and `volumes` its rest positions
     /// and particle volumes. Bind it (Solver::bind) to a DamageState over the same bonds before
     /// use.
@@ -126,11 +128,16 @@ private:
     /// The vectorised pass's pairs, in tiles of kTile particles (setUpPairArrays): per pair its
     /// ends, upper and lower copies, rest length, bond scale, critical stretch and whether it
     /// is a pad; per directed bond, its pair there.
-    static constexpr int kTile = 8;
     std::vector<int> tileBegin_;  ///< per tile, and one past the last: its first pair
     std::vector<int> pairFirst_, pairSecond_, pairUpper_, pairTwin_, slotOf_;
     std::vector<std::uint8_t> pairPad_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
+    /// Per row of kTile pairs (setUpPairRows): the first particles of its ends' runs (-1: not
+    /// runs), and the class of its one rest length, scale and limit (-1: not one); per class,
+    /// those values.
+    std::vector<int> rowRunFirst_, rowRunSecond_, rowClass_;
+    std::vector<double> classRest_, classScale_, classLimit_;
+    void setUpPairRows();
     /// The first pair of the tile starting at particle p (a tile's first, or the particle count).
     int pairsBefore(int p) const { return tileBegin_[(p + kTile - 1) / kTile]; }
     /// p rounded down to its tile's first particle.

@@ -158,6 +158,11 @@ struct Simd {
     static M both(M a, M b) { return _mm256_and_pd(a, b); }
     static V blend(V a, V b, M m) { return _mm256_blendv_pd(a, b, m); }  ///< m ? b : a
     static unsigned bits(M m) { return unsigned(_mm256_movemask_pd(m)); }
+    static M maskOf(unsigned bits) {
+        const __m256i lane = _mm256_setr_epi64x(1, 2, 4, 8);
+        return _mm256_castsi256_pd(
+            _mm256_cmpeq_epi64(_mm256_and_si256(_mm256_set1_epi64x(bits), lane), lane));
+    }
     template <class Read>
     [[gnu::always_inline]] static V lanes(Read read) {
         return _mm256_setr_pd(read(0), read(1), read(2), read(3));
@@ -242,6 +247,7 @@ struct Simd {
     static M both(M a, M b) { return M(a & b); }
     static V blend(V a, V b, M m) { return _mm512_mask_blend_pd(m, a, b); }
     static unsigned bits(M m) { return m; }
+    static M maskOf(unsigned bits) { return M(bits); }
     template <class Read>
     [[gnu::always_inline]] static V lanes(Read read) {
         return _mm512_setr_pd(read(0), read(1), read(2), read(3), read(4), read(5), read(6),

@@ -15,7 +15,6 @@ namespace rend::sim {
 namespace {
 
 constexpr std::int16_t kFree = -1;
-constexpr int kBlock = 1024;  // particles per partial sum; fixed, so sums do not depend on threads
 
 // A NaN or an overflow never becomes a limit: anything not below the cap is the cap.
 double capped(double value, double cap) { return value < cap ? value : cap; }
@@ -96,18 +95,40 @@ BlowUpGuard::BlowUpGuard(const MembraneParams& params, double worstRatio,
 // for finiteness: x moves by dt v from a finite start, so a non-finite x has had a non-finite v
 // first (or one over the limit), and skipping it halves the memory the pass reads. The blocks
 // are fixed, and each is summed in a fixed order: the same bits for any thread count.
+namespace {
+
+GuardInput guardInput(const BlowUpGuard::State& s, double limit, const Eigen::Vector3d& gravity,
+                      bool hasGravity, bool theta) {
+    return {s.v.data()->data(),
+            s.force.empty() ? nullptr : s.force.data()->data(),
+            s.mass.data(),
+            s.constraint.data(),
+            theta && !s.theta.empty() ? s.theta.data() : nullptr,
+            limit * limit,
+            {gravity.x(), gravity.y(), gravity.z()},
+            hasGravity};
+}
+
+BlowUpGuard::Sample sampleOf(const GuardSums& r) {
+    return {r.kinetic,     r.boundaryPower, r.gravityPower, r.maxSpeedSquared,
+            r.maxAbsTheta, r.fastest,       r.firstBad};
+}
+
+}  // namespace
+
 void BlowUpGuard::sampleBlock(const State& s, int begin, int end, Sample& out) const {
-    GuardInput in{s.v.data()->data(),
-                  s.force.empty() ? nullptr : s.force.data()->data(),
-                  s.mass.data(),
-                  s.constraint.data(),
-                  s.theta.empty() ? nullptr : s.theta.data(),
-                  speedLimit_ * speedLimit_,
-                  {gravity_.x(), gravity_.y(), gravity_.z()},
-                  hasGravity_};
-    const GuardSums r = guardSums(in, begin, end);
-    out = {r.kinetic,     r.boundaryPower, r.gravityPower, r.maxSpeedSquared,
-           r.maxAbsTheta, r.fastest,       r.firstBad};
+    out = sampleOf(guardSums(guardInput(s, speedLimit_, gravity_, hasGravity_, true), begin, end));
+}
+
+void BlowUpGuard::beginMotion(int first, int last) {
+    motionFirst_ = first, motionLast_ = last, motionReady_ = false;
+    motion_.resize((last - first + kBlock - 1) / kBlock);
+}
+
+void BlowUpGuard::sampleMotion(const State& s, int block) {
+    const int begin = motionFirst_ + block * kBlock, end = std::min(motionLast_, begin + kBlock);
+    motion_[block] = sampleOf(
+        guardMotionSums(guardInput(s, speedLimit_, gravity_, hasGravity_, false), begin, end));
 }
 
 BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
@@ -115,9 +136,22 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
     const int n = s.domain ? s.domain->slab().end : int(s.v.size());
     const int blocks = (n - first + kBlock - 1) / kBlock;
     blocks_.assign(blocks, Sample{});
+    // The motion the integrator sampled as it went, and theta now; else both now.
+    const bool sampled = motionReady_ && motionFirst_ == first && motionLast_ == n;
 #pragma omp parallel for schedule(static) if (n - first >= kParallelThreshold)
-    for (int b = 0; b < blocks; ++b)
-        sampleBlock(s, first + b * kBlock, std::min(n, first + (b + 1) * kBlock), blocks_[b]);
+    for (int b = 0; b < blocks; ++b) {
+        const int begin = first + b * kBlock, end = std::min(n, begin + kBlock);
+        if (!sampled) {
+            sampleBlock(s, begin, end, blocks_[b]);
+            continue;
+        }
+        GuardSums sums{motion_[b].kinetic,      motion_[b].boundaryPower,
+                       motion_[b].gravityPower, motion_[b].maxSpeedSquared,
+                       motion_[b].maxAbsTheta,  motion_[b].fastest,
+                       motion_[b].firstBad};
+        if (!s.theta.empty()) addThetaSums(sums, guardThetaSums(s.theta.data(), begin, end));
+        blocks_[b] = sampleOf(sums);
+    }
     Sample total;
     for (const Sample& b : blocks_) {
         total.kinetic += b.kinetic;
@@ -160,6 +194,7 @@ void BlowUpGuard::addWork(const State& state, const Sample& s) {
 
 void BlowUpGuard::check(const State& state, const std::function<double()>& totalEnergy) {
     const Sample s = sample(state);
+    motionReady_ = false;
     if (s.firstBad >= 0) report(state, s, "");
     if (!started_) {
         started_ = true;

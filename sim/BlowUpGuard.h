@@ -93,6 +93,18 @@ public:
     };
     Sample sample(const State& state) const;
 
+    /// Particles per block of a sample: fixed, so that its sums do not depend on the threads.
+    static constexpr int kBlock = 1024;
+    /// The motion half of the next check's sample (all but theta), block by block, taken by the
+    /// integrator right after it moved each block, while the block is in cache: the bits
+    /// check() would take. beginMotion() over the particles [first, last) a check samples,
+    /// sampleMotion() for each of their blocks (from any thread), endMotion(). Until the next
+    /// check, v, force, mass and constraint must not change, or forgetMotion() must be called.
+    void beginMotion(int first, int last);
+    void sampleMotion(const State& state, int block);
+    void endMotion() { motionReady_ = true; }
+    void forgetMotion() { motionReady_ = false; }
+
     /// What a checkpoint keeps (sim/StateArchive.h): the energy budget and the growth watch.
     template <class Self, class Archive>
     static void visitState(Self& s, Archive& a) {
@@ -118,6 +130,9 @@ private:
     int growingSteps_ = 0;
     double growthProduct_ = 1.0;
     mutable std::vector<Sample> blocks_;
+    std::vector<Sample> motion_;  ///< sampleMotion()'s, per block of [motionFirst_, motionLast_)
+    int motionFirst_ = 0, motionLast_ = 0;
+    bool motionReady_ = false;
 };
 
 }  // namespace rend::sim

@@ -229,15 +229,21 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
     for (int a = 0; a < 3; ++a) k.gravity[a] = params_.gravity[a];
     const double floor = contact_ ? contact_->groundOnlyFloor() : Contact::kNoFloor;
     k.floor = floor;
-    constexpr int kBlock = 1024;
+    // The guard's blocks: each is sampled for the step's check right after it moved, in cache.
+    constexpr int kBlock = BlowUpGuard::kBlock;
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
+    const BlowUpGuard::State moved{{}, v_, force_, {}, mass_, {}, constraint_};
+    guard_.beginMotion(begin_, end_);
     bool below = false;
 #pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold) \
     reduction(||                                                                   \
               : below)
-    for (int b = 0; b < blocks; ++b)
+    for (int b = 0; b < blocks; ++b) {
         below =
             kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock)) || below;
+        guard_.sampleMotion(moved, b);
+    }
+    guard_.endMotion();
     return floor == Contact::kNoFloor || below;
 }
 
@@ -245,9 +251,10 @@ void Membrane::collide(double tNext, bool mayTouch) {
     if (!contact_ || !contact_->hasColliders()) return;
     const double t0 = omp_get_wtime();
     contact_->place(tNext);
-    if (mayTouch)
+    if (mayTouch) {
         contact_->resolveColliders(x_, v_, mass_, free_, begin_, end_);
-    else
+        guard_.forgetMotion();  // the colliders may have moved some
+    } else
         contact_->touchNothing();
     contactSeconds_ += omp_get_wtime() - t0;
 }
@@ -337,12 +344,14 @@ void Membrane::stepVelocityVerlet() {
 }
 
 void Membrane::step() {
+    guard_.forgetMotion();  // sampled again if the step ends with kickAndDrift()
     if (params_.time.integrator == Integrator::VelocityVerlet)
         stepVelocityVerlet();
     else
         stepSymplecticEuler();
     if (remesher_ && (steps_ + 1) % params_.remesh.every == 0) {
         remesher_->remesh(x_, v_, mass_, damageState_.bondAlive(), free_);
+        guard_.forgetMotion();
         forcesCurrent_ = false;
     }
     if (diffusion_) {

@@ -43,7 +43,7 @@ inline bool allFree(const std::int16_t* constraint, int count) {
 
 /// The guard's sums of one chain (sim/BlowUpGuard.h).
 struct GuardPart {
-    double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0, maxAbsTheta = 0.0;
+    double kinetic = 0.0, boundaryPower = 0.0, gravityPower = 0.0;
 };
 
 /// Particle i's speed check, its share of the sums and whether it is the fastest so far.
@@ -65,9 +65,15 @@ inline void guardVisit(const GuardInput& g, int i, GuardPart& p, GuardSums& s) {
 }
 
 /// The largest |theta| skips NaN (std::max keeps its first argument); NaN and inf are bad.
-inline void guardVisitTheta(const GuardInput& g, int i, GuardPart& p, GuardSums& s) {
-    if (!std::isfinite(g.theta[i]) && (s.firstBad < 0 || i < s.firstBad)) s.firstBad = i;
-    p.maxAbsTheta = std::max(p.maxAbsTheta, std::abs(g.theta[i]));
+inline void guardVisitTheta(const double* theta, int i, GuardSums& s) {
+    if (!std::isfinite(theta[i]) && s.firstBad < 0) s.firstBad = i;
+    s.maxAbsTheta = std::max(s.maxAbsTheta, std::abs(theta[i]));
+}
+
+GuardSums guardThetaScalar(const double* theta, int begin, int end) {
+    GuardSums s;
+    for (int i = begin; i < end; ++i) guardVisitTheta(theta, i, s);
+    return s;
 }
 
 /// Four chains, of every fourth particle, added in a fixed order.
@@ -78,19 +84,12 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     for (; i + 4 <= end; i += 4)
         for (int k = 0; k < 4; ++k) guardVisit(g, i + k, p[k], s);
     for (; i < end; ++i) guardVisit(g, i, p[0], s);
-    if (g.theta) {
-        for (i = begin; i + 4 <= end; i += 4)
-            for (int k = 0; k < 4; ++k) guardVisitTheta(g, i + k, p[k], s);
-        for (; i < end; ++i) guardVisitTheta(g, i, p[0], s);
-    }
     const auto total = [&](double GuardPart::*field) {
         return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
     };
     s.kinetic = total(&GuardPart::kinetic);
     s.boundaryPower = total(&GuardPart::boundaryPower);
     s.gravityPower = total(&GuardPart::gravityPower);
-    s.maxAbsTheta = std::max(std::max(p[0].maxAbsTheta, p[1].maxAbsTheta),
-                             std::max(p[2].maxAbsTheta, p[3].maxAbsTheta));
     return s;
 }
 
@@ -192,7 +191,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     const __m512d gz = _mm512_set1_pd(g.gravity[2]);
     const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
     __m512d kinetic = _mm512_setzero_pd(), gravityPower = _mm512_setzero_pd();
-    __m512d best = _mm512_setzero_pd(), maxTheta = _mm512_setzero_pd();
+    __m512d best = _mm512_setzero_pd();
     __m512i bestAt = _mm512_set1_epi64(-1);
     int i = begin;
     for (; i + 8 <= end; i += 8) {
@@ -219,27 +218,14 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             _mm512_mask_blend_epi64(faster, bestAt, _mm512_add_epi64(_mm512_set1_epi64(i), iota));
     }
     for (; i < end; ++i) guardVisit(g, i, p, s);
-    if (g.theta) {
-        const __m512d finite = _mm512_set1_pd(std::numeric_limits<double>::max());
-        for (i = begin; i + 8 <= end; i += 8) {
-            const __m512d a = _mm512_abs_pd(_mm512_loadu_pd(g.theta + i));
-            const unsigned bad = _mm512_cmp_pd_mask(a, finite, _CMP_NLE_UQ);
-            const int at = i + __builtin_ctz(bad | 256u);
-            if (bad != 0 && (s.firstBad < 0 || at < s.firstBad)) s.firstBad = at;
-            maxTheta = _mm512_max_pd(a, maxTheta);  // a NaN lane keeps maxTheta
-        }
-        for (; i < end; ++i) guardVisitTheta(g, i, p, s);
-    }
     s.kinetic = laneSum(kinetic) + p.kinetic;
     s.gravityPower = laneSum(gravityPower) + p.gravityPower;
     s.boundaryPower = p.boundaryPower;
-    double speeds[8], thetas[8];
+    double speeds[8];
     std::int64_t at[8];
-    _mm512_storeu_pd(speeds, best), _mm512_storeu_pd(thetas, maxTheta);
+    _mm512_storeu_pd(speeds, best);
     _mm512_storeu_si512(at, bestAt);
-    s.maxAbsTheta = p.maxAbsTheta;
     for (int l = 0; l < 8; ++l) {
-        s.maxAbsTheta = std::max(s.maxAbsTheta, thetas[l]);
         const bool higher = speeds[l] > s.maxSpeedSquared;
         const bool tie = speeds[l] == s.maxSpeedSquared && at[l] < s.fastest;
         if (at[l] >= 0 && (higher || tie)) s.maxSpeedSquared = speeds[l], s.fastest = int(at[l]);
@@ -247,15 +233,54 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     return s;
 }
 
+// Eight at a time; NaN and inf are bad (not <= the largest double), a NaN lane keeps the max.
+[[gnu::target("avx2,avx512f")]] GuardSums guardThetaAvx512(const double* theta, int begin,
+                                                           int end) {
+    GuardSums s;
+    const __m512d finite = _mm512_set1_pd(std::numeric_limits<double>::max());
+    __m512d largest = _mm512_setzero_pd();
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        const __m512d a = _mm512_abs_pd(_mm512_loadu_pd(theta + i));
+        const unsigned bad = _mm512_cmp_pd_mask(a, finite, _CMP_NLE_UQ);
+        if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(bad);
+        largest = _mm512_max_pd(a, largest);
+    }
+    for (; i < end; ++i) guardVisitTheta(theta, i, s);
+    double lanes[8];
+    _mm512_storeu_pd(lanes, largest);
+    for (const double l : lanes) s.maxAbsTheta = std::max(s.maxAbsTheta, l);
+    return s;
+}
+
 #endif
 
 }  // namespace
 
-GuardSums guardSums(const GuardInput& g, int begin, int end) {
+GuardSums guardMotionSums(const GuardInput& g, int begin, int end) {
 #if defined(__x86_64__)
     if (simdWidth() == 8) return guardAvx512(g, begin, end);
 #endif
     return guardScalar(g, begin, end);
+}
+
+GuardSums guardThetaSums(const double* theta, int begin, int end) {
+#if defined(__x86_64__)
+    if (simdWidth() == 8) return guardThetaAvx512(theta, begin, end);
+#endif
+    return guardThetaScalar(theta, begin, end);
+}
+
+void addThetaSums(GuardSums& motion, const GuardSums& theta) {
+    motion.maxAbsTheta = std::max(motion.maxAbsTheta, theta.maxAbsTheta);
+    if (theta.firstBad >= 0 && (motion.firstBad < 0 || theta.firstBad < motion.firstBad))
+        motion.firstBad = theta.firstBad;
+}
+
+GuardSums guardSums(const GuardInput& g, int begin, int end) {
+    GuardSums s = guardMotionSums(g, begin, end);
+    if (g.theta) addThetaSums(s, guardThetaSums(g.theta, begin, end));
+    return s;
 }
 
 int simdWidth() {

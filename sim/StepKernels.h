@@ -56,6 +56,11 @@ struct GuardSums {
 /// (the lowest index at it), the driven ones' |f . v|, the largest |theta|, and the lowest index
 /// whose speed is not within the limit or whose theta is not finite.
 GuardSums guardSums(const GuardInput& g, int begin, int end);
+/// Its two halves: the motion's (g.theta unread), and theta's (maxAbsTheta and firstBad only),
+/// which addThetaSums() joins into the motion's; guardSums() is the two joined.
+GuardSums guardMotionSums(const GuardInput& g, int begin, int end);
+GuardSums guardThetaSums(const double* theta, int begin, int end);
+void addThetaSums(GuardSums& motion, const GuardSums& theta);
 
 /// Lanes of the vector kernels here and in sim/PairKernels.h: 8 with AVX-512, 4 with AVX2, 1
 /// without. REND_SIMD=avx2 or REND_SIMD=scalar in the environment caps it (to compare them; every

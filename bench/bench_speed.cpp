@@ -75,7 +75,9 @@ Row measure(rend::sim::MembraneParams params, int side, int cores) {
     row.setupSeconds = secondsSince(start);
     row.particles = membrane.particleCount();
     row.bondsPerParticle = double(membrane.bonds().directedCount()) / row.particles;
-    omp_set_num_threads(cores);
+    // One thread first: steps on every core before it left the one-thread figure 10-20% slower
+    // at 10^5 particles (and taskset -c 0 agreed with the one-thread-first figure).
+    omp_set_num_threads(1);
     membrane.step();  // the solvers' workspaces are allocated at the first step
     row.bytesPerParticle = (heapBytes() - before) / row.particles;
     row.ns1 = nsPerParticleStep(membrane, 1, 2.0);

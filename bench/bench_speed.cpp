@@ -66,8 +66,17 @@ struct Row {
     double ns1 = 0.0, nsAll = 0.0;
 };
 
-Row measure(rend::sim::MembraneParams params, int side, int cores) {
-    params.sheet.size = Eigen::Vector2d::Constant((side - 1) * params.sheet.dx);
+/// The stretch scene at `side` x `side` particles, loaded at that size so that its grips (the
+/// edges' strips) are placed on the sheet's edges, as `rend run --set sheet.size=...` does.
+rend::sim::MembraneParams stretchSheet(int side) {
+    const std::string size = std::to_string((side - 1) * 0.02);
+    return rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/stretch.toml",
+                           {"sheet.lattice=\"square\"", "time.dt=1e-4", "sheet.dx=0.02",
+                            "sheet.size=[" + size + ", " + size + "]"})
+        .sim;
+}
+
+Row measure(const rend::sim::MembraneParams& params, int cores) {
     Row row;
     const double before = heapBytes();
     const auto start = Clock::now();
@@ -150,8 +159,6 @@ int main(int argc, char** argv) {
     long largest = 10000000;
     for (int k = 1; k + 1 < argc; ++k)
         if (std::string(argv[k]) == "--largest") largest = std::atol(argv[k + 1]);
-    const rend::Scene scene = rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/stretch.toml",
-                                              {"sheet.lattice=\"square\"", "time.dt=1e-4"});
     const int cores = rend::usableCores();
     const int width = rend::sim::simdWidth();
     std::printf(
@@ -171,7 +178,7 @@ int main(int argc, char** argv) {
     double rendAt1e4 = 0.0;
     for (const int side : {101, 317, 1001, 3163}) {
         if (side > 101 && long(side) * side > largest * 1.01) break;  // 10^4 always runs
-        const Row r = measure(scene.sim, side, cores);
+        const Row r = measure(stretchSheet(side), cores);
         if (side == 101) rendAt1e4 = r.ns1;
         std::printf("%12ld %10.2f %12.0f %10.2f %14.1f %14.1f %8.2f\n", r.particles,
                     r.bondsPerParticle, r.bytesPerParticle, r.setupSeconds, r.ns1, r.nsAll,

@@ -87,25 +87,12 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
         double coef = in.scale[u] * f / length;
         if constexpr (kBreak) coef = past ? 0.0 : coef;
-        double* slot = force + 4 * std::size_t(u - base);
-        slot[0] = coef * rx, slot[1] = coef * ry, slot[2] = coef * rz, slot[3] = 0.0;
+        double* slot = force + slotAt(unsigned(u - base), out.rows);
+        const int stride = slotStride(out.rows);
+        slot[0] = coef * rx, slot[stride] = coef * ry, slot[2 * stride] = coef * rz;
+        if (!out.rows) slot[3] = 0.0;
     }
     return stiffest;
-}
-
-void gatherLoop(const PairGather& g, int begin, int end) {
-    for (int i = begin; i < end; ++i) {
-        double sum[3] = {0.0, 0.0, 0.0};
-        for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
-            if (g.alive[b])
-                for (int k = 0; k < 3; ++k)
-                    sum[k] -= g.pairForce[4 * (unsigned(g.pairOf[b]) & g.slotMask) + k];
-        for (int b = g.upperBegin[i]; b < g.offsets[i + 1]; ++b)
-            if (g.alive[b])
-                for (int k = 0; k < 3; ++k)
-                    sum[k] += g.pairForce[4 * (unsigned(g.pairOf[b]) & g.slotMask) + k];
-        for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
-    }
 }
 
 /// Bit k of `bits` as byte k (0 or 1) of the result: one store for a mask's lanes.
@@ -272,11 +259,11 @@ struct Simd {
         avx2::Simd::loadPositions(p, index + 4, x1, y1, z1);
         x = join(x0, x1), y = join(y0, y1), z = join(z0, z1);
     }
+    /// The lanes' x, y and z in their row's slots (eight lanes: the slots are in rows).
     [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz) {
-        avx2::Simd::storeSlots(slot, _mm512_castpd512_pd256(fx), _mm512_castpd512_pd256(fy),
-                               _mm512_castpd512_pd256(fz));
-        avx2::Simd::storeSlots(slot + 16, _mm512_extractf64x4_pd(fx, 1),
-                               _mm512_extractf64x4_pd(fy, 1), _mm512_extractf64x4_pd(fz, 1));
+        _mm512_storeu_pd(slot, fx);
+        _mm512_storeu_pd(slot + kPairTile, fy);
+        _mm512_storeu_pd(slot + 2 * kPairTile, fz);
     }
 };
 
@@ -288,31 +275,6 @@ struct Simd {
 #else
 #pragma GCC pop_options
 #endif
-
-// A pair force is one four-lane load; the lanes add as the scalar sums do.
-[[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
-    const int* __restrict offsets = g.offsets;
-    const int* __restrict upperBegin = g.upperBegin;
-    const int* __restrict pairOf = g.pairOf;
-    const std::uint8_t* __restrict alive = g.alive;
-    const double* __restrict pairForce = g.pairForce;
-    const unsigned mask = g.slotMask;
-    double* __restrict force = g.force;
-    for (int i = begin; i < end; ++i) {
-        __m256d sum = _mm256_setzero_pd();
-        for (int b = offsets[i]; b < upperBegin[i]; ++b)
-            if (alive[b])
-                sum = _mm256_sub_pd(sum,
-                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
-        for (int b = upperBegin[i]; b < offsets[i + 1]; ++b)
-            if (alive[b])
-                sum = _mm256_add_pd(sum,
-                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
-        double lanes[4];
-        _mm256_storeu_pd(lanes, sum);
-        force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];
-    }
-}
 
 #endif
 
@@ -339,6 +301,8 @@ double pairsFor(const LinearPairInput& in, const LinearPairOutput& out, int begi
 
 }  // namespace
 
+bool slotRows() { return simdWidth() == 8; }
+
 double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin,
                         int end) {
     switch (in.law->kind) {
@@ -352,13 +316,6 @@ double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, 
                              : pairsFor<BondLawKind::Elastoplastic, false>(in, out, begin, end);
     }
     return 1.0;
-}
-
-void gatherPairForces(const PairGather& g, int begin, int end) {
-#if defined(__x86_64__)
-    if (simdWidth() >= 4) return gatherAvx2(g, begin, end);
-#endif
-    gatherLoop(g, begin, end);
 }
 
 }  // namespace rend::sim

@@ -2,11 +2,12 @@
 // The vectorised first pass of the force loop of every bond law (eqs. 18-20 with eqs. 10,
 // 27-28, the diffusion's strain and weakening, the power law's look-ahead and the elastoplastic
 // history): each pair's force on its smaller index, from structure-of-arrays inputs, for a range
-// of pairs. sim/PeridynamicBonds.cpp gathers the pair forces per particle. Eight pairs at a time
+// of pairs. sim/PairSums.h sums the pair forces per particle. Eight pairs at a time
 // with AVX-512 where the CPU has it, else four with AVX2, else one at a time
 // (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt (no
 // fused multiply-add), so their bits are the same. The width is sim/StepKernels.h's simdWidth().
 
+#include <cstddef>
 #include <cstdint>
 
 #include "sim/BondLaw.h"
@@ -50,31 +51,31 @@ struct LinearPairInput {
     const double *classRest = nullptr, *classScale = nullptr, *classLimit = nullptr;
 };
 
+/// Where a pair's force lies in its slots. In rows (eight lanes wide, sim/PairSums.h's tile
+/// sums): rows of kPairTile slots, the x of the row's pairs, then their y, then their z, so that
+/// eight lanes store and load them without a transpose. Else x y z 0 per slot (one load per pair
+/// for a particle's sum).
+inline constexpr int kSlotRow = 3 * kPairTile;
+inline std::size_t slotAt(unsigned s, bool rows) {
+    return rows ? kSlotRow * std::size_t(s / kPairTile) + s % kPairTile : 4 * std::size_t(s);
+}
+/// How far apart a slot's x, y and z lie.
+inline int slotStride(bool rows) { return rows ? kPairTile : 1; }
+/// Whether the slots are in rows: the width is 8.
+bool slotRows();
+
 struct LinearPairOutput {
-    /// Per pair u, at slot u - slotBase: x y z 0, its force on i; zero past its limit.
+    /// Pair u's force on i at slotAt(u - slotBase, rows): zero past its limit. slotBase is a
+    /// multiple of kPairTile.
     double* force = nullptr;
     std::uint8_t* over = nullptr;  ///< per pair: past its limit (only with a limit)
     int slotBase = 0;
+    bool rows = false;  ///< slotRows()
 };
 
 /// Pairs [begin, end). Dead bonds are computed too: the gather skips them. Returns the power
 /// law's largest look-ahead tangent over c among the living, unbroken, compressed pairs (at
 /// least 1; 1 without a look-ahead).
 double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end);
-
-/// The second pass: each particle's sum of its living bonds' pair forces in CSR order, minus
-/// where it is the pair's larger index (sim/Bonds.h's BondPairs).
-struct PairGather {
-    const int* offsets = nullptr;
-    const int* upperBegin = nullptr;
-    const int* pairOf = nullptr;  ///< per directed bond: its pair u
-    const std::uint8_t* alive = nullptr;
-    const double* pairForce = nullptr;  ///< LinearPairOutput::force: pair u at slot u & slotMask
-    double* force = nullptr;            ///< x y z per particle
-    unsigned slotMask = ~0u;            ///< a ring of 2^k slots, or all bits: slot u is pair u
-};
-
-/// Particles [begin, end).
-void gatherPairForces(const PairGather& g, int begin, int end);
 
 }  // namespace rend::sim

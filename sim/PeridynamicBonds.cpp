@@ -14,6 +14,7 @@
 
 #include "sim/Fracture.h"
 #include "sim/PairKernels.h"
+#include "sim/PairSums.h"
 #include "sim/Parallel.h"
 #include "sim/SolverRegistry.h"
 
@@ -110,6 +111,8 @@ void PeridynamicBonds::setUpPairArrays() {
                                       pairsBefore(tileStart(std::max(0, p - reach_))));
     ringPairs_ = 1;
     while (ringPairs_ < window) ringPairs_ *= 2;
+    sumTiles_ = PairSumTiles::build(bonds_.offsets.data(), pairs_.upperBegin.data(), slotOf_.data(),
+                                    n, unsigned(ringPairs_ - 1));
 }
 
 // Per row of a tile (its particles' k-th pairs, side by side): whether its ends are two runs of
@@ -434,7 +437,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     const int n = bonds_.particleCount();
     force.resize(n);
     const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
-    work.slots.resize(4 * std::size_t(ringPairs_) * teams);
+    // Each ring has kPairTile doubles before it: the tile sums' masked loads (sim/PairSums.h)
+    // address a row's slots from a lane before its first.
+    const bool rows = slotRows();
+    const std::size_t ringSize = kPairTile + (rows ? 3 : 4) * std::size_t(ringPairs_);
+    work.slots.resize(ringSize * teams);
     if (kBreak) work.over.resize(pairFirst_.size());
     const LinearPairInput in =
         pairInput(s, kUpdateBonds, kBreak,
@@ -457,14 +464,14 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         const int to = t + 1 == threads
                            ? slab_.end
                            : tileStart(slab_.ghostBegin + int(span * (t + 1) / threads));
-        double* ring = work.slots.data() + 4 * std::size_t(ringPairs_) * t;
+        double* ring = work.slots.data() + ringSize * t + kPairTile;
         const auto compute = [&](const LinearPairInput& input, int p, int q) {
             double most = 1.0;
             for (int u = pairsBefore(p), end = pairsBefore(q); u < end;) {  // split at the wrap
                 const int base = u - int(unsigned(u) & (ringPairs_ - 1));
                 const int stop = std::min(end, base + ringPairs_);
-                most = std::max(most,
-                                linearPairForces(input, {ring, work.over.data(), base}, u, stop));
+                most = std::max(
+                    most, linearPairForces(input, {ring, work.over.data(), base, rows}, u, stop));
                 u = stop;
             }
             return most;
@@ -477,7 +484,9 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                           damage_->bondAlive().data(),
                           ring,
                           force.data()->data(),
-                          unsigned(ringPairs_ - 1)};
+                          unsigned(ringPairs_ - 1),
+                          &sumTiles_,
+                          rows};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
             stiffest = std::max(stiffest, compute(in, p, q));

@@ -19,6 +19,7 @@
 #include "sim/Bonds.h"
 #include "sim/Lattice.h"
 #include "sim/Material.h"
+#include "sim/PairSums.h"
 #include "sim/Params.h"
 #include "sim/Solver.h"
 
@@ -93,7 +94,7 @@ private:
     /// as three arrays, and whether it is past its limit).
     struct PairWorkspace : Workspace {
         std::vector<Eigen::Vector3d> pairForce;
-        std::vector<double> slots;  ///< the vectorised laws': a ring of x y z 0 per thread
+        std::vector<double> slots;  ///< the vectorised laws': a ring of slots per thread
         std::vector<std::uint8_t> over;
     };
     /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
@@ -138,6 +139,7 @@ private:
     std::vector<int> rowRunFirst_, rowRunSecond_, rowClass_;
     std::vector<double> classRest_, classScale_, classLimit_;
     void setUpPairRows();
+    PairSumTiles sumTiles_;  ///< the tiles whose sums run eight lanes wide (sim/PairSums.h)
     /// The first pair of the tile starting at particle p (a tile's first, or the particle count).
     int pairsBefore(int p) const { return tileBegin_[(p + kTile - 1) / kTile]; }
     /// p rounded down to its tile's first particle.

@@ -290,7 +290,10 @@ int simdWidth() {
         int lanes = 1;
 #if defined(__x86_64__)
         if (__builtin_cpu_supports("avx2")) lanes = 4;
-        if (__builtin_cpu_supports("avx512f")) lanes = 8;
+        // AVX-512 with byte masks and bit extraction (every AVX-512 CPU but Xeon Phi).
+        if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+            __builtin_cpu_supports("bmi2"))
+            lanes = 8;
 #endif
         if (wanted == "scalar") return 1;
         if (wanted == "avx2") return std::min(lanes, 4);

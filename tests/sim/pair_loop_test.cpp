@@ -50,6 +50,9 @@ struct Case {
     /// A sheet of 1 x 0.5 m: ~5,800 particles, over the threads' threshold, and more pairs
     /// than a thread's ring of slots holds (sim/PeridynamicBonds.h), so that it wraps.
     bool large = false;
+    /// A square lattice within 1.5 dx: eight bonds each, the tile sums' groups of lanes
+    /// (sim/PairSums.h); else hexagonal within 2 dx (18 bonds: one particle at a time).
+    bool square = false;
 };
 
 /// Particle i's force summed over both copies of its bonds, one at a time: the loop as the
@@ -85,6 +88,7 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     MembraneParams p;
     p.sheet.size = c.large ? Eigen::Vector2d(1.0, 0.5) : Eigen::Vector2d(0.2, 0.1);
     p.sheet.dx = 0.01;
+    if (c.square) p.sheet.lattice = LatticeKind::Square;
     p.material.youngsModulus = 1e5;
     p.material.law = c.law;
     p.material.yieldStrain = 0.002;
@@ -92,8 +96,9 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     if (c.theta)
         p.material.expansion = 0.01, p.material.stiffnessLoss = 0.4, p.material.strengthLoss = 0.3;
     const Lattice lattice = generateLattice(p.sheet);
-    const BondFamilies bonds = buildBondFamilies(lattice.positions, 2.0 * p.sheet.dx);
-    p.sheet.horizonFactor = 2.0;
+    const double horizon = c.square ? 1.5 : 2.0;
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, horizon * p.sheet.dx);
+    p.sheet.horizonFactor = horizon;
     const std::vector<double> volumes(lattice.positions.size(),
                                       lattice.particleArea * p.sheet.thickness);
     PeridynamicBonds solver(p, lattice, bonds, lattice.positions, volumes);
@@ -269,7 +274,11 @@ INSTANTIATE_TEST_SUITE_P(EveryLaw, PairLoop,
                                            Case{BondLawKind::Elastoplastic, true, true},
                                            Case{BondLawKind::Linear, true, true, true},
                                            Case{BondLawKind::PowerLaw, true, true, true},
-                                           Case{BondLawKind::Elastoplastic, true, true, true}));
+                                           Case{BondLawKind::Elastoplastic, true, true, true},
+                                           Case{BondLawKind::Linear, true, true, false, true},
+                                           Case{BondLawKind::PowerLaw, true, true, false, true},
+                                           Case{BondLawKind::Elastoplastic, true, true, true, true},
+                                           Case{BondLawKind::Linear, false, false, true, true}));
 
 TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
     const BondFamilies bonds = sheetBonds(0.3, 0.2, 1.5);

@@ -1,0 +1,297 @@
+#include "sim/PairSums.h"
+
+#include <immintrin.h>
+
+#include <bit>
+#include <cstring>
+
+#include "sim/PairKernels.h"
+#include "sim/StepKernels.h"
+
+namespace rend::sim {
+namespace {
+
+constexpr int kTile = PairSumTiles::kTile;
+/// A group of one lane is summed as one particle: its rows would cost more than its own loop.
+constexpr int kFewestLanes = 2;
+
+/// Lanes [first, end)'s pairs of one row as at most two runs; false where they are not.
+bool rowOf(const int* pair, int first, int end, int& runA, int& runB, int& split) {
+    runA = pair[first] - first, split = end;
+    for (int l = first + 1; l < end && split == end; ++l)
+        if (pair[l] - l != runA) split = l;
+    runB = split < end ? pair[split] - split : runA;
+    for (int l = first; l < end; ++l) {
+        const int from = l < split ? first : split, run = l < split ? runA : runB;
+        // A run stays inside a group of eight slots, so it never wraps around a ring.
+        if (pair[l] < 0 || pair[l] - l != run || pair[l] / kTile != pair[from] / kTile)
+            return false;
+    }
+    return true;
+}
+
+/// A particle's bonds and lower copies among them.
+struct Shape {
+    int bonds, lower;
+    bool operator==(const Shape&) const = default;
+};
+
+/// Whether lanes [first, end) of tile t, of `bonds` bonds each, form a group; its rows if so.
+bool groupOf(const int* offsets, const int* pairOf, int t, int first, int end, int bonds,
+             std::vector<int>& a, std::vector<int>& b, std::vector<int>& split) {
+    a.resize(bonds), b.resize(bonds), split.resize(bonds);
+    for (int k = 0; k < bonds; ++k) {
+        int pair[kTile] = {};
+        for (int l = first; l < end; ++l) pair[l] = pairOf[offsets[kTile * t + l] + k];
+        if (!rowOf(pair, first, end, a[k], b[k], split[k])) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, const int* pairOf,
+                                 int n, unsigned slotMask) {
+    PairSumTiles s;
+    s.slotMask = slotMask, s.directedBonds = offsets[n];
+    // Where lane 0's x would lie, for lane l's pair u: l before u's.
+    const auto at = [&](int u, int l) { return int(slotAt(unsigned(u) & slotMask, true)) - l; };
+    const int tiles = n / kTile;
+    s.groupFirst.assign(tiles + 1, 0);
+    std::vector<int> a, b, split;
+    const auto shape = [&](int i) {
+        return Shape{offsets[i + 1] - offsets[i], upperBegin[i] - offsets[i]};
+    };
+    for (int t = 0; t < tiles; ++t) {
+        // Greedy: each group as many lanes as keep one shape and two runs per row.
+        for (int first = 0, end; first < kTile; first = end) {
+            const Shape own = shape(kTile * t + first);
+            const bool vector = own.bonds > 0 && own.bonds <= kMostBonds;
+            end = first + 1;
+            while (vector && end < kTile && shape(kTile * t + end) == own &&
+                   groupOf(offsets, pairOf, t, first, end + 1, own.bonds, a, b, split))
+                ++end;
+            Group group{std::uint8_t(first), std::uint8_t(end), 0, std::uint8_t(own.lower), -1};
+            if (vector && end - first >= kFewestLanes &&
+                groupOf(offsets, pairOf, t, first, end, own.bonds, a, b, split)) {
+                group.bonds = std::uint8_t(own.bonds), group.rowFirst = int(s.atA.size());
+                for (int k = 0; k < own.bonds; ++k) {
+                    const unsigned lanes = ((1u << (end - first)) - 1u) << first;
+                    s.fromA.push_back(std::uint8_t(lanes & ((1u << split[k]) - 1u)));
+                    s.atA.push_back(at(a[k] + first, first));
+                    s.atB.push_back(split[k] < end ? at(b[k] + split[k], split[k]) : s.atA.back());
+                }
+            }
+            s.groups.push_back(group);
+        }
+        s.groupFirst[t + 1] = int(s.groups.size());
+    }
+    return s;
+}
+
+namespace {
+
+/// The slots of pair u: x, y slotStride() after, z twice that.
+inline const double* slotOf(const PairGather& g, int u) {
+    return g.pairForce + slotAt(unsigned(u) & g.slotMask, g.rows);
+}
+
+void gatherParticle(const PairGather& g, int i) {
+    const int stride = slotStride(g.rows);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
+        if (g.alive[b])
+            for (int k = 0; k < 3; ++k) sum[k] -= slotOf(g, g.pairOf[b])[stride * k];
+    for (int b = g.upperBegin[i]; b < g.offsets[i + 1]; ++b)
+        if (g.alive[b])
+            for (int k = 0; k < 3; ++k) sum[k] += slotOf(g, g.pairOf[b])[stride * k];
+    for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
+}
+
+void gatherLoop(const PairGather& g, int begin, int end) {
+    for (int i = begin; i < end; ++i) gatherParticle(g, i);
+}
+
+#if defined(__x86_64__)
+// Eight lanes: simdWidth() is 8 only with AVX-512 F and BW and BMI2.
+#define REND_TILE_TARGET gnu::target("avx2,avx512f,avx512bw,bmi2")
+
+/// Which of a group's bonds live, bit k of its lane l at l * bonds + k: one or two 64-byte
+/// loads (at most four lanes each where eight would not fit).
+struct GroupLife {
+    std::uint64_t low = 0, high = 0, stride = 0;
+    int lanesPerWord;
+
+    [[REND_TILE_TARGET]] static std::uint64_t word(const std::uint8_t* alive, int bytes) {
+        const __mmask64 in = bytes >= 64 ? ~__mmask64(0) : (__mmask64(1) << bytes) - 1;
+        const __m512i flags = _mm512_maskz_loadu_epi8(in, alive);
+        return _mm512_test_epi8_mask(flags, flags);
+    }
+    [[REND_TILE_TARGET]] GroupLife(const std::uint8_t* alive, int bonds, int lanes) {
+        lanesPerWord = bonds * lanes <= 64 ? lanes : kTile / 2;
+        for (int l = 0; l < lanesPerWord; ++l) stride |= std::uint64_t(1) << (l * bonds);
+        low = word(alive, lanesPerWord * bonds);
+        if (lanesPerWord < lanes)
+            high = word(alive + lanesPerWord * bonds, (lanes - lanesPerWord) * bonds);
+    }
+    /// Bit l: the group's lane l's k-th bond lives.
+    [[REND_TILE_TARGET]] unsigned of(int k) const {
+        const std::uint64_t at = stride << k;
+        return unsigned(_pext_u64(low, at) | (_pext_u64(high, at) << lanesPerWord));
+    }
+};
+
+/// One row's x (or y, z, kPairTile after) of its lanes: those of run A and those of run B, one
+/// masked load each. `a` and `b` point at the slots lane 0 would have in each run (a ring has
+/// kPairTile doubles before it); other lanes are zero.
+[[REND_TILE_TARGET]] inline __m512d rowLanes(const double* a, const double* b, __mmask8 fromA,
+                                             __mmask8 fromB) {
+    return _mm512_mask_loadu_pd(_mm512_maskz_loadu_pd(fromA, a), fromB, b);
+}
+
+/// Where the 24 doubles of x y z per particle come from: per part of eight, the lane of x (or 8
+/// + the lane of y), the lane of z, and which are z's.
+struct Interleave {
+    long long fromXY[3][8], fromZ[3][8];
+    unsigned isZ[3];
+};
+constexpr Interleave kInterleave = [] {
+    Interleave m{};
+    for (int q = 0; q < 3 * kTile; ++q) {
+        const int part = q / 8, p = q % 8, component = q % 3, lane = q / 3;
+        m.fromXY[part][p] = component == 1 ? 8 + lane : lane, m.fromZ[part][p] = lane;
+        if (component == 2) m.isZ[part] |= 1u << p;
+    }
+    return m;
+}();
+
+[[REND_TILE_TARGET]] inline void storeParticles(double* out, __m512d x, __m512d y, __m512d z) {
+    for (int part = 0; part < 3; ++part) {
+        const __m512d xy =
+            _mm512_permutex2var_pd(x, _mm512_loadu_si512(kInterleave.fromXY[part]), y);
+        _mm512_storeu_pd(out + 8 * part, _mm512_mask_permutexvar_pd(
+                                             xy, __mmask8(kInterleave.isZ[part]),
+                                             _mm512_loadu_si512(kInterleave.fromZ[part]), z));
+    }
+}
+
+struct Lanes3 {
+    __m512d x, y, z;
+};
+
+/// A group's row's terms added to (or taken from) each living lane's sums; `first` is the
+/// group's first lane, `lanes` all of its lanes.
+[[REND_TILE_TARGET]] inline void addRow(const PairGather& g, const PairSumTiles& s, int row,
+                                        int first, __mmask8 lanes, unsigned living, bool minus,
+                                        Lanes3& sum) {
+    const double *a = g.pairForce + s.atA[row], *b = g.pairForce + s.atB[row];
+    const __mmask8 fromA = s.fromA[row], fromB = __mmask8(lanes & ~fromA);
+    const __mmask8 on = __mmask8(living);
+    __m512d fx, fy, fz;
+    if (fromA == 0xff) {  // a whole row of one run: an upper copy's row, inside a lattice
+        fx = _mm512_loadu_pd(a), fy = _mm512_loadu_pd(a + kPairTile);
+        fz = _mm512_loadu_pd(a + 2 * kPairTile);
+    } else {
+        fx = rowLanes(a, b, fromA, fromB),
+        fy = rowLanes(a + kPairTile, b + kPairTile, fromA, fromB);
+        fz = rowLanes(a + 2 * kPairTile, b + 2 * kPairTile, fromA, fromB);
+    }
+    if (minus) {
+        sum.x = _mm512_mask_sub_pd(sum.x, on, sum.x, fx);
+        sum.y = _mm512_mask_sub_pd(sum.y, on, sum.y, fy);
+        sum.z = _mm512_mask_sub_pd(sum.z, on, sum.z, fz);
+    } else {
+        sum.x = _mm512_mask_add_pd(sum.x, on, sum.x, fx);
+        sum.y = _mm512_mask_add_pd(sum.y, on, sum.y, fy);
+        sum.z = _mm512_mask_add_pd(sum.z, on, sum.z, fz);
+    }
+}
+
+/// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
+/// group (a group without rows one particle at a time, after the tile's store).
+[[REND_TILE_TARGET]] void sumWholeTile(const PairGather& g, const PairSumTiles& s, int t,
+                                       const PairSumTiles::Group& group) {
+    Lanes3 sum{_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
+    const GroupLife life(g.alive + g.offsets[kTile * t], group.bonds, kTile);
+    int k = 0;
+    for (; k < group.lower; ++k)
+        addRow(g, s, group.rowFirst + k, 0, __mmask8(0xff), life.of(k), true, sum);
+    for (; k < group.bonds; ++k)
+        addRow(g, s, group.rowFirst + k, 0, __mmask8(0xff), life.of(k), false, sum);
+    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z);
+}
+
+[[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t) {
+    if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]];
+        one.endLane == kTile && one.bonds > 0)
+        return sumWholeTile(g, s, t, one);
+    Lanes3 sum{_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
+    unsigned alone = 0;
+    for (int q = s.groupFirst[t]; q < s.groupFirst[t + 1]; ++q) {
+        const PairSumTiles::Group& group = s.groups[q];
+        const int first = group.firstLane, lanes = group.endLane - first;
+        const unsigned mask = ((1u << lanes) - 1u) << first;
+        if (group.bonds == 0) {
+            alone |= mask;
+            continue;
+        }
+        const GroupLife life(g.alive + g.offsets[kTile * t + first], group.bonds, lanes);
+        int k = 0;
+        for (; k < group.lower; ++k)
+            addRow(g, s, group.rowFirst + k, first, __mmask8(mask), life.of(k) << first, true, sum);
+        for (; k < group.bonds; ++k)
+            addRow(g, s, group.rowFirst + k, first, __mmask8(mask), life.of(k) << first, false,
+                   sum);
+    }
+    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z);
+    for (; alone != 0; alone &= alone - 1) gatherParticle(g, kTile * t + std::countr_zero(alone));
+}
+
+[[REND_TILE_TARGET]] void gatherTiles(const PairGather& g, int begin, int end) {
+    int i = begin;
+    for (; i < end && i % kTile != 0; ++i) gatherParticle(g, i);
+    for (; i + kTile <= end; i += kTile) sumTile(g, *g.tiles, i / kTile);
+    for (; i < end; ++i) gatherParticle(g, i);
+}
+
+// A pair force is one four-lane load (x y z 0 slots); the lanes add as the scalar sums do.
+[[gnu::target("avx2")]] void gatherAvx2(const PairGather& g, int begin, int end) {
+    const int* __restrict offsets = g.offsets;
+    const int* __restrict upperBegin = g.upperBegin;
+    const int* __restrict pairOf = g.pairOf;
+    const std::uint8_t* __restrict alive = g.alive;
+    const double* __restrict pairForce = g.pairForce;
+    const unsigned mask = g.slotMask;
+    double* __restrict force = g.force;
+    for (int i = begin; i < end; ++i) {
+        __m256d sum = _mm256_setzero_pd();
+        for (int b = offsets[i]; b < upperBegin[i]; ++b)
+            if (alive[b])
+                sum = _mm256_sub_pd(sum,
+                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
+        for (int b = upperBegin[i]; b < offsets[i + 1]; ++b)
+            if (alive[b])
+                sum = _mm256_add_pd(sum,
+                                    _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
+        double lanes[4];
+        _mm256_storeu_pd(lanes, sum);
+        force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];
+    }
+}
+#endif
+
+}  // namespace
+
+void gatherPairForces(const PairGather& g, int begin, int end) {
+#if defined(__x86_64__)
+    if (g.rows) {
+        if (g.tiles && g.tiles->slotMask == g.slotMask && simdWidth() == 8)
+            return gatherTiles(g, begin, end);
+    } else if (simdWidth() >= 4) {
+        return gatherAvx2(g, begin, end);
+    }
+#endif
+    gatherLoop(g, begin, end);
+}
+
+}  // namespace rend::sim

@@ -1,0 +1,60 @@
+#pragma once
+// The second pass of the vectorised force loop (sim/PairKernels.h computes each pair's force
+// into a slot): each particle's sum of its living bonds' pair forces in CSR order, minus where it
+// is the pair's larger index (sim/Bonds.h's BondPairs). One particle at a time, or, with
+// AVX-512, eight at once: a tile (sim/PeridynamicBonds.h's order) whose particles have the same
+// number of bonds, the same number of lower copies and, bond by bond, their pairs in at most two
+// runs of consecutive slots, as almost every tile of a regular lattice has. Each lane adds the
+// same terms in the same order as one particle's loop, skipping the dead bonds by a mask: the
+// same bits.
+
+#include <cstdint>
+#include <vector>
+
+namespace rend::sim {
+
+/// The tiles of kTile particles whose sums run eight lanes wide, each in groups of
+/// consecutive lanes with the same number of bonds and of lower copies among them, whose k-th
+/// bonds' pairs lie in at most two runs of consecutive slots (a tile inside a regular lattice's
+/// row is one group; one where a row ends, three or four).
+struct PairSumTiles {
+    static constexpr int kTile = 8;
+    static constexpr int kMostBonds = 16;  ///< a group's life flags in two 64-byte loads
+    std::vector<int> groupFirst;           ///< per whole tile, and one past the last
+    struct Group {
+        std::uint8_t firstLane, endLane, bonds, lower;  ///< bonds 0: one particle at a time
+        int rowFirst;
+    };
+    std::vector<Group> groups;
+    /// Per row (the k-th bonds of a group's lanes side by side): the lanes whose pairs lie in
+    /// run A (the rest in run B), and where lane 0's x would lie in each run's slots (lane l's is
+    /// l after), for a ring of slotMask + 1 slots.
+    std::vector<std::uint8_t> fromA;
+    std::vector<int> atA, atB;
+    unsigned slotMask = ~0u;
+    int directedBonds = 0;  ///< offsets[n]
+
+    /// The tiles of particles [0, n) from the CSR offsets, upper copies' starts and each
+    /// directed bond's pair, for a ring of slotMask + 1 slots (a power of 2, at least kTile).
+    static PairSumTiles build(const int* offsets, const int* upperBegin, const int* pairOf, int n,
+                              unsigned slotMask);
+};
+
+struct PairGather {
+    const int* offsets = nullptr;
+    const int* upperBegin = nullptr;
+    const int* pairOf = nullptr;  ///< per directed bond: its pair u
+    const std::uint8_t* alive = nullptr;
+    /// LinearPairOutput::force: pair u at slotAt(u & slotMask, rows) (sim/PairKernels.h); in
+    /// rows, with kPairTile doubles before the first slot that may be addressed (never read).
+    const double* pairForce = nullptr;
+    double* force = nullptr;              ///< x y z per particle
+    unsigned slotMask = ~0u;              ///< a ring of 2^k slots, or all bits: slot u is pair u
+    const PairSumTiles* tiles = nullptr;  ///< null: one particle at a time
+    bool rows = false;                    ///< the slots are in rows (slotRows())
+};
+
+/// Particles [begin, end).
+void gatherPairForces(const PairGather& g, int begin, int end);
+
+}  // namespace rend::sim

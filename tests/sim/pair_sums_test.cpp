@@ -1,0 +1,161 @@
+// Each particle's sum of its pair forces (sim/PairSums.h): eight particles at once, in groups of
+// lanes, has the bits of one particle at a time, for any range, any ring of slots, dead bonds and
+// any lattice (ctest's kernels.* run this at each vector width).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <vector>
+
+#include "sim/Bonds.h"
+#include "sim/Lattice.h"
+#include "sim/PairKernels.h"
+#include "sim/PairSums.h"
+#include "sim/Random.h"
+
+using namespace rend::sim;
+
+namespace {
+
+constexpr int kTile = PairSumTiles::kTile;
+
+BondFamilies sheetBonds(double width, double height, LatticeKind kind, double horizon) {
+    SheetParams sheet;
+    sheet.size = {width, height};
+    sheet.dx = 0.01;
+    sheet.lattice = kind;
+    return buildBondFamilies(generateLattice(sheet).positions, horizon * sheet.dx);
+}
+
+/// Each directed bond's pair as PeridynamicBonds numbers them: the k-th upper copy of tile t's
+/// lane l is pair first(t) + kTile k + l; a lower copy has its upper copy's pair.
+std::vector<int> tilePairs(const BondFamilies& bonds, const BondPairs& pairs) {
+    const int n = bonds.particleCount();
+    std::vector<int> pairOf(bonds.directedCount(), -1);
+    int first = 0;
+    for (int t = 0; t * kTile < n; ++t) {
+        int most = 0;
+        for (int i = kTile * t; i < std::min(n, kTile * (t + 1)); ++i)
+            most = std::max(most, bonds.offsets[i + 1] - pairs.upperBegin[i]);
+        for (int i = kTile * t; i < std::min(n, kTile * (t + 1)); ++i)
+            for (int b = pairs.upperBegin[i]; b < bonds.offsets[i + 1]; ++b) {
+                const int u = first + kTile * (b - pairs.upperBegin[i]) + i % kTile;
+                pairOf[b] = pairOf[pairs.twin[pairs.pairOf[b]]] = u;
+            }
+        first += kTile * most;
+    }
+    return pairOf;
+}
+
+struct Sums {
+    explicit Sums(const BondFamilies& bonds, std::vector<int> pairs, unsigned slotMask)
+        : bonds(bonds),
+          pairs(buildBondPairs(bonds)),
+          pairOf(std::move(pairs)),
+          alive(bonds.directedCount(), 1),
+          tiles(PairSumTiles::build(bonds.offsets.data(), this->pairs.upperBegin.data(),
+                                    pairOf.data(), bonds.particleCount(), slotMask)),
+          slotMask(slotMask) {
+        const int most = *std::max_element(pairOf.begin(), pairOf.end());
+        const unsigned used = std::min(unsigned(most), slotMask) + 1;
+        slots.assign(kTile + slotAt(used, true) + kSlotRow, 0.0);
+        for (std::size_t k = kTile; k < slots.size(); ++k)
+            slots[k] = 2.0 * uniformFromHash(11, int(k)) - 1.0;
+        for (int b = 0; b < int(alive.size()); ++b) {
+            const double draw = uniformFromHash(12, b);  // some dead, some "alive" as 2
+            alive[b] = draw < 0.1 ? 0 : draw < 0.2 ? 2 : 1;
+        }
+    }
+    /// The sums of particles [begin, end), with or without the tiles.
+    std::vector<double> of(int begin, int end, bool withTiles) const {
+        std::vector<double> force(3 * bonds.particleCount(), -7.0);
+        const PairGather g{bonds.offsets.data(),
+                           pairs.upperBegin.data(),
+                           pairOf.data(),
+                           alive.data(),
+                           slots.data() + kTile,
+                           force.data(),
+                           slotMask,
+                           withTiles ? &tiles : nullptr,
+                           true};
+        gatherPairForces(g, begin, end);
+        return force;
+    }
+    const BondFamilies& bonds;
+    BondPairs pairs;
+    std::vector<int> pairOf;
+    std::vector<std::uint8_t> alive;
+    PairSumTiles tiles;
+    unsigned slotMask;
+    std::vector<double> slots;
+};
+
+void expectSameBits(const Sums& sums, int begin, int end) {
+    const std::vector<double> alone = sums.of(begin, end, false), tiled = sums.of(begin, end, true);
+    EXPECT_EQ(std::memcmp(alone.data(), tiled.data(), alone.size() * sizeof(double)), 0)
+        << "particles " << begin << " to " << end;
+}
+
+struct Case {
+    LatticeKind lattice;
+    double horizon;  ///< in dx: 1.5 gives 8 bonds (square) or 6 (hexagonal); 2.2 gives 12
+};
+
+class PairSums : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PairSums, HaveTheBitsOfOneParticleAtATime) {
+    const Case c = GetParam();
+    const BondFamilies bonds = sheetBonds(0.23, 0.11, c.lattice, c.horizon);
+    const int n = bonds.particleCount();
+    const BondPairs pairs = buildBondPairs(bonds);
+    for (const unsigned slotMask : {~0u, 63u}) {  // every pair its slot, or a ring of 64
+        const Sums tiled(bonds, tilePairs(bonds, pairs), slotMask);
+        expectSameBits(tiled, 0, n);
+        expectSameBits(tiled, 3, n - 5);                // ranges that start and end inside a tile
+        const Sums csr(bonds, pairs.pairOf, slotMask);  // CSR pairs: few runs
+        expectSameBits(csr, 0, n);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Lattices, PairSums,
+                         ::testing::Values(Case{LatticeKind::Square, 1.5},
+                                           Case{LatticeKind::Hexagonal, 1.5},
+                                           Case{LatticeKind::Square, 2.2},
+                                           Case{LatticeKind::Hexagonal, 2.5}));
+
+TEST(PairSumTiles, TileInsideALatticeRowIsOneGroupOfEightLanes) {
+    // 24 + 1 particles per row: many tiles lie inside a row, the others cross its end.
+    const BondFamilies bonds = sheetBonds(0.24, 0.1, LatticeKind::Square, 1.5);
+    const BondPairs pairs = buildBondPairs(bonds);
+    const std::vector<int> pairOf = tilePairs(bonds, pairs);
+    const PairSumTiles tiles = PairSumTiles::build(bonds.offsets.data(), pairs.upperBegin.data(),
+                                                   pairOf.data(), bonds.particleCount(), 63u);
+    const int rowLength = 25, tileCount = bonds.particleCount() / kTile;
+    int whole = 0, inside = 0;
+    for (int t = 0; t < tileCount; ++t) {
+        const int first = kTile * t, last = first + kTile - 1;
+        // Inside a row, and so are its lower copies' partners (one column further left).
+        const bool interior = first / rowLength == last / rowLength && first % rowLength > 1 &&
+                              last % rowLength < rowLength - 2 && first >= rowLength &&
+                              last < bonds.particleCount() - rowLength;
+        if (!interior) continue;
+        ++inside;
+        const int groups = tiles.groupFirst[t + 1] - tiles.groupFirst[t];
+        const PairSumTiles::Group& g = tiles.groups[tiles.groupFirst[t]];
+        whole += groups == 1 && g.endLane == kTile && g.bonds == 8 && g.lower == 4;
+    }
+    EXPECT_GT(inside, 10);
+    EXPECT_EQ(whole, inside);
+    // Every lane of every whole tile is in exactly one group, in order.
+    for (int t = 0; t < tileCount; ++t) {
+        int lane = 0;
+        for (int q = tiles.groupFirst[t]; q < tiles.groupFirst[t + 1]; ++q) {
+            EXPECT_EQ(tiles.groups[q].firstLane, lane);
+            lane = tiles.groups[q].endLane;
+        }
+        EXPECT_EQ(lane, kTile);
+    }
+}
+
+}  // namespace

@@ -74,12 +74,12 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
             Group group{std::uint8_t(first), std::uint8_t(end), 0, std::uint8_t(own.lower), -1};
             if (vector && end - first >= kFewestLanes &&
                 groupOf(offsets, pairOf, t, first, end, own.bonds, a, b, split)) {
-                group.bonds = std::uint8_t(own.bonds), group.rowFirst = int(s.atA.size());
+                group.bonds = std::uint8_t(own.bonds), group.rowFirst = int(s.rows.size());
                 for (int k = 0; k < own.bonds; ++k) {
                     const unsigned lanes = ((1u << (end - first)) - 1u) << first;
-                    s.fromA.push_back(std::uint8_t(lanes & ((1u << split[k]) - 1u)));
-                    s.atA.push_back(at(a[k] + first, first));
-                    s.atB.push_back(split[k] < end ? at(b[k] + split[k], split[k]) : s.atA.back());
+                    const int atA = at(a[k] + first, first);
+                    s.rows.push_back({atA, split[k] < end ? at(b[k] + split[k], split[k]) : atA,
+                                      std::uint8_t(lanes & ((1u << split[k]) - 1u))});
                 }
             }
             s.groups.push_back(group);
@@ -184,8 +184,9 @@ struct Lanes3 {
 [[REND_TILE_TARGET]] inline void addRow(const PairGather& g, const PairSumTiles& s, int row,
                                         int first, __mmask8 lanes, unsigned living, bool minus,
                                         Lanes3& sum) {
-    const double *a = g.pairForce + s.atA[row], *b = g.pairForce + s.atB[row];
-    const __mmask8 fromA = s.fromA[row], fromB = __mmask8(lanes & ~fromA);
+    const PairSumTiles::Row& r = s.rows[row];
+    const double *a = g.pairForce + r.atA, *b = g.pairForce + r.atB;
+    const __mmask8 fromA = r.fromA, fromB = __mmask8(lanes & ~fromA);
     const __mmask8 on = __mmask8(living);
     __m512d fx, fy, fz;
     if (fromA == 0xff) {  // a whole row of one run: an upper copy's row, inside a lattice
@@ -209,22 +210,60 @@ struct Lanes3 {
 
 /// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
 /// group (a group without rows one particle at a time, after the tile's store).
-[[REND_TILE_TARGET]] void sumWholeTile(const PairGather& g, const PairSumTiles& s, int t,
-                                       const PairSumTiles::Group& group) {
-    Lanes3 sum{_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
-    const GroupLife life(g.alive + g.offsets[kTile * t], group.bonds, kTile);
-    int k = 0;
-    for (; k < group.lower; ++k)
-        addRow(g, s, group.rowFirst + k, 0, __mmask8(0xff), life.of(k), true, sum);
-    for (; k < group.bonds; ++k)
-        addRow(g, s, group.rowFirst + k, 0, __mmask8(0xff), life.of(k), false, sum);
-    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z);
+/// A row's x (or y, z: `at` after) of all eight lanes, from one run or two.
+[[REND_TILE_TARGET]] inline __m512d wholeRow(const double* a, const double* b, __mmask8 fromA,
+                                             int at) {
+    if (fromA == 0xff) return _mm512_loadu_pd(a + at);
+    return _mm512_mask_blend_pd(fromA, _mm512_loadu_pd(b + at), _mm512_loadu_pd(a + at));
+}
+
+/// A tile of one group of eight lanes with at most eight bonds each (a regular lattice's
+/// interior): its rows' pointers and its life flags (one 64-byte load) kept in registers;
+/// compiled for each count of bonds, so that its loop unrolls.
+template <int kBonds>
+[[REND_TILE_TARGET]] void sumWholeTile(const PairGather& g, const PairSumTiles::Row* row, int lower,
+                                       const std::uint8_t* alive, double* out) {
+    constexpr __mmask64 kFlags =
+        kBonds == kTile ? ~__mmask64(0) : (__mmask64(1) << (kTile * kBonds)) - 1;
+    constexpr std::uint64_t kStride = [] {  // bit 0 of each lane's flags
+        std::uint64_t stride = 0;
+        for (int l = 0; l < kTile; ++l) stride |= std::uint64_t(1) << (l * kBonds);
+        return stride;
+    }();
+    const __m512i bytes = _mm512_maskz_loadu_epi8(kFlags, alive);
+    const std::uint64_t life = _mm512_test_epi8_mask(bytes, bytes);
+    __m512d x = _mm512_setzero_pd(), y = x, z = x;
+#pragma GCC unroll 8
+    for (int k = 0; k < kBonds; ++k) {
+        const double *a = g.pairForce + row[k].atA, *b = g.pairForce + row[k].atB;
+        const __mmask8 fromA = row[k].fromA, on = __mmask8(_pext_u64(life, kStride << k));
+        const __m512d fx = wholeRow(a, b, fromA, 0), fy = wholeRow(a, b, fromA, kPairTile);
+        const __m512d fz = wholeRow(a, b, fromA, 2 * kPairTile);
+        if (k < lower) {
+            x = _mm512_mask_sub_pd(x, on, x, fx), y = _mm512_mask_sub_pd(y, on, y, fy);
+            z = _mm512_mask_sub_pd(z, on, z, fz);
+        } else {
+            x = _mm512_mask_add_pd(x, on, x, fx), y = _mm512_mask_add_pd(y, on, y, fy);
+            z = _mm512_mask_add_pd(z, on, z, fz);
+        }
+    }
+    storeParticles(out, x, y, z);
 }
 
 [[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t) {
-    if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]];
-        one.endLane == kTile && one.bonds > 0)
-        return sumWholeTile(g, s, t, one);
+    if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]]; one.endLane == kTile) {
+        const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
+        const std::uint8_t* alive = g.alive + g.offsets[kTile * t];
+        double* out = g.force + 3 * kTile * std::size_t(t);
+        switch (one.bonds) {  // the square lattice's 8 and the hexagonal lattice's 6
+            case 8:
+                return sumWholeTile<8>(g, rows, one.lower, alive, out);
+            case 6:
+                return sumWholeTile<6>(g, rows, one.lower, alive, out);
+            default:
+                break;
+        }
+    }
     Lanes3 sum{_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
     unsigned alone = 0;
     for (int q = s.groupFirst[t]; q < s.groupFirst[t + 1]; ++q) {

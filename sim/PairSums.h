@@ -26,11 +26,14 @@ struct PairSumTiles {
         int rowFirst;
     };
     std::vector<Group> groups;
-    /// Per row (the k-th bonds of a group's lanes side by side): the lanes whose pairs lie in
-    /// run A (the rest in run B), and where lane 0's x would lie in each run's slots (lane l's is
-    /// l after), for a ring of slotMask + 1 slots.
-    std::vector<std::uint8_t> fromA;
-    std::vector<int> atA, atB;
+    /// A row (the k-th bonds of a group's lanes side by side): where lane 0's x would lie in
+    /// each run's slots (lane l's is l after), for a ring of slotMask + 1 slots, and the lanes
+    /// whose pairs lie in run A (the rest in run B).
+    struct Row {
+        int atA, atB;
+        std::uint8_t fromA;
+    };
+    std::vector<Row> rows;
     unsigned slotMask = ~0u;
     int directedBonds = 0;  ///< offsets[n]
 
@@ -46,7 +49,8 @@ struct PairGather {
     const int* pairOf = nullptr;  ///< per directed bond: its pair u
     const std::uint8_t* alive = nullptr;
     /// LinearPairOutput::force: pair u at slotAt(u & slotMask, rows) (sim/PairKernels.h); in
-    /// rows, with kPairTile doubles before the first slot that may be addressed (never read).
+    /// rows, with kPairTile readable doubles before the first slot and after the last (read,
+    /// never summed).
     const double* pairForce = nullptr;
     double* force = nullptr;              ///< x y z per particle
     unsigned slotMask = ~0u;              ///< a ring of 2^k slots, or all bits: slot u is pair u

@@ -437,10 +437,12 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     const int n = bonds_.particleCount();
     force.resize(n);
     const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
-    // Each ring has kPairTile doubles before it: the tile sums' masked loads (sim/PairSums.h)
-    // address a row's slots from a lane before its first.
+    // In rows, each ring has kPairTile doubles before and after it: the tile sums
+    // (sim/PairSums.h) read a row's lanes from a run's slot of lane 0, which may lie before the
+    // first slot, and read up to kPairTile - 1 past the last.
     const bool rows = slotRows();
-    const std::size_t ringSize = kPairTile + (rows ? 3 : 4) * std::size_t(ringPairs_);
+    const std::size_t ringSize =
+        rows ? 2 * kPairTile + 3 * std::size_t(ringPairs_) : 4 * std::size_t(ringPairs_);
     work.slots.resize(ringSize * teams);
     if (kBreak) work.over.resize(pairFirst_.size());
     const LinearPairInput in =
@@ -464,7 +466,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         const int to = t + 1 == threads
                            ? slab_.end
                            : tileStart(slab_.ghostBegin + int(span * (t + 1) / threads));
-        double* ring = work.slots.data() + ringSize * t + kPairTile;
+        double* ring = work.slots.data() + ringSize * t + (rows ? kPairTile : 0);
         const auto compute = [&](const LinearPairInput& input, int p, int q) {
             double most = 1.0;
             for (int u = pairsBefore(p), end = pairsBefore(q); u < end;) {  // split at the wrap

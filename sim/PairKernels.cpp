@@ -77,9 +77,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             f = 2.0 * in.powerC * (s - 1.0 / (s * s * s)) +
                 in.powerCStar * in.powerN * (wholePower(s, in.powerN - 1.0) - 1.0);
         } else if constexpr (kLaw == BondLawKind::Elastoplastic) {  // eq. 20
-            const PlasticState state = in.law->yieldStep(eta, in.plastic[in.upper[u]]);
-            if (kUpdate && !past && in.alive[in.upper[u]])
-                in.plastic[in.upper[u]] = in.plastic[in.twin[u]] = state;
+            const PlasticState state = in.law->yieldStep(eta, PlasticState{in.held[u]});
+            if (kUpdate && !past && in.alive[in.upper[u]]) in.held[u] = state.maxStrain;
             f = in.law->forceAs<BondLawKind::Elastoplastic>(eta, state);
         } else {
             f = in.c * eta;  // eq. 18

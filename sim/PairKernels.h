@@ -40,7 +40,9 @@ struct LinearPairInput {
     const std::uint8_t* alive = nullptr;  ///< per directed bond
     const int* upper = nullptr;           ///< per pair: its upper copy
     const int* twin = nullptr;            ///< per pair: its lower copy
-    PlasticState* plastic = nullptr;      ///< per directed bond (elastoplastic)
+    /// Per pair (elastoplastic): the largest strain its bond has reached (BondLaw's
+    /// PlasticState), moved on by advance() for the living, unbroken bonds.
+    double* held = nullptr;
     /// Per kPairTile pairs from a multiple of it (a vector, or two): where their ends are runs
     /// of consecutive particles, the first of each run (else -1); where their rest lengths,
     /// bond scales and limits are each one value, its class in the tables (else -1). Such

@@ -403,8 +403,15 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
     updates.stiffest = stiffest;
 }
 
-LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, bool breakable,
-                                            PlasticState* plastic) const {
+void PeridynamicBonds::syncHistory() const {
+    if (!heldAhead_) return;
+    for (std::size_t u = 0; u < pairHeld_.size(); ++u)
+        if (!pairPad_[u])
+            plastic_[pairUpper_[u]].maxStrain = plastic_[pairTwin_[u]].maxStrain = pairHeld_[u];
+    heldAhead_ = false;
+}
+
+LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, bool breakable) const {
     LinearPairInput in{pairFirst_.data(),
                        pairSecond_.data(),
                        pairRest_.data(),
@@ -422,7 +429,16 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
     in.twin = pairTwin_.data();
-    in.plastic = plastic;
+    if (!plastic_.empty()) {
+        if (heldBehind_) {
+            pairHeld_.resize(pairUpper_.size());
+            for (std::size_t u = 0; u < pairHeld_.size(); ++u)
+                pairHeld_[u] = plastic_[pairUpper_[u]].maxStrain;
+            heldBehind_ = false;
+        }
+        in.held = pairHeld_.data();
+        heldAhead_ = heldAhead_ || update;
+    }
     in.runFirst = rowRunFirst_.data(), in.runSecond = rowRunSecond_.data();
     in.uniform = rowClass_.data();
     in.classRest = classRest_.data(), in.classScale = classScale_.data();
@@ -445,9 +461,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         rows ? 2 * kPairTile + 3 * std::size_t(ringPairs_) : 4 * std::size_t(ringPairs_);
     work.slots.resize(ringSize * teams);
     if (kBreak) work.over.resize(pairFirst_.size());
-    const LinearPairInput in =
-        pairInput(s, kUpdateBonds, kBreak,
-                  kUpdateBonds ? updates.plastic : const_cast<PlasticState*>(plastic_.data()));
+    const LinearPairInput in = pairInput(s, kUpdateBonds, kBreak);
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
     double stiffest = 1.0;
@@ -568,11 +582,13 @@ void PeridynamicBonds::advance(const StepState& s, Workspace& work,
 }
 
 void PeridynamicBonds::reportStrength(DamageState& damage) const {
+    syncHistory();
     for (std::size_t b = 0; b < plastic_.size(); ++b)
         damage.weaken(int(b), lawOf(int(b)).strengthLeft(plastic_[b]));  // eq. 27
 }
 
 double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
+    syncHistory();
     return strainEnergyOf(s, 0, bonds_.particleCount());
 }
 
@@ -595,6 +611,7 @@ double PeridynamicBonds::strainEnergyOf(const StepState& s, int begin, int end) 
 }
 
 Eigen::Matrix3d PeridynamicBonds::particleStress(int i, const StepState& s) const {
+    syncHistory();
     const auto& x = s.x;
     Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
     for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {

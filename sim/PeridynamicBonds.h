@@ -49,8 +49,14 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const StepState& s, Workspace& work) const override;
     double stiffening() const override { return stiffening_; }
-    void saveState(StateWriter& out) const override { out(plastic_), out(stiffening_); }
-    void loadState(StateReader& in) override { in(plastic_), in(stiffening_); }
+    void saveState(StateWriter& out) const override {
+        syncHistory();
+        out(plastic_), out(stiffening_);
+    }
+    void loadState(StateReader& in) override {
+        in(plastic_), in(stiffening_);
+        heldAhead_ = false, heldBehind_ = true;
+    }
     void reportStrength(DamageState& damage) const override;
     bool restrictTo(const Slab& slab) override {
         slab_ = slab;
@@ -58,10 +64,16 @@ public:
     }
     /// The strain energy of the bonds of the particles of its slab (half of each bond's).
     double slabStrainEnergy(const StepState& s) const {
+        syncHistory();
         return strainEnergyOf(s, slab_.begin, slab_.end);
     }
-    /// Per directed bond, the elastoplastic law's history (empty for the other laws).
-    std::vector<PlasticState>& plasticState() { return plastic_; }
+    /// Per directed bond, the elastoplastic law's history (empty for the other laws). What is
+    /// written to it is seen by the next step.
+    std::vector<PlasticState>& plasticState() {
+        syncHistory();
+        heldBehind_ = true;
+        return plastic_;
+    }
 
     const BondLaw& law() const { return law_; }
     /// Directed bond b's force on its particle per unit of f(eta) (sim/BondLaw.h).
@@ -98,8 +110,7 @@ private:
         std::vector<std::uint8_t> over;
     };
     /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
-    LinearPairInput pairInput(const StepState& s, bool update, bool breakable,
-                              PlasticState* plastic) const;
+    LinearPairInput pairInput(const StepState& s, bool update, bool breakable) const;
     /// The vectorised laws' loop: sim/PairKernels.h's pairs and their sums, fused per thread.
     template <bool kUpdateBonds, bool kBreak>
     void vectorBondForces(const StepState& s, PairWorkspace& work,
@@ -153,9 +164,16 @@ private:
     double horizon_ = 0.0;
     BondLaw law_;
     double criticalStretch_ = 0.0;
-    std::vector<double> bondScale_;        ///< force on i per unit of f(eta), see BondLaw.h
-    std::vector<double> stretchFactor_;    ///< per bond, from material maps; empty: all 1
-    std::vector<PlasticState> plastic_;    ///< per bond; empty unless the law is elastoplastic
+    std::vector<double> bondScale_;      ///< force on i per unit of f(eta), see BondLaw.h
+    std::vector<double> stretchFactor_;  ///< per bond, from material maps; empty: all 1
+    /// Per bond; empty unless the law is elastoplastic. The vectorised pass keeps it per pair in
+    /// pairHeld_ instead: plastic_ follows it when read (syncHistory()), and it follows
+    /// plastic_ when that was written (heldBehind_).
+    mutable std::vector<PlasticState> plastic_;
+    mutable std::vector<double> pairHeld_;
+    mutable bool heldAhead_ = false, heldBehind_ = true;
+    /// plastic_ from pairHeld_ where the pass moved it on.
+    void syncHistory() const;
     std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
     std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
     std::vector<double> ratioFactor_;      ///< per bond, c*/c over the law's (maps); empty: all 1

@@ -25,6 +25,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "sim/LawExp.h"
 #include "sim/Params.h"
 
 namespace rend::sim {
@@ -98,9 +99,10 @@ struct BondLaw {
         return std::pow(s, k);
     }
 
-    /// Eq. 20's force on the loading path at strain eta >= eta0.
+    /// Eq. 20's force on the loading path at strain eta >= eta0 (lawExp: the vector kernels'
+    /// bits).
     double yieldForce(double eta) const {
-        return c * yieldStrain * std::exp(-softening * (eta - yieldStrain) / yieldStrain);
+        return c * yieldStrain * lawExp(-softening * (eta - yieldStrain) / yieldStrain);
     }
 
     /// Permanent strain left after loading to maxStrain (0 while it stayed elastic).

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "sim/BondLaw.h"
+#include "sim/LawExp.h"
 #include "sim/SimdRuns.h"
 #include "sim/StepKernels.h"
 
@@ -136,6 +137,19 @@ struct Simd {
     static V max(V a, V b) { return _mm256_max_pd(a, b); }
     static V min(V a, V b) { return _mm256_min_pd(a, b); }
     static M gt(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+    static M ge(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GE_OQ); }
+    /// p 2^n1 2^n2 for the n of t = x log2e + lawexp::kShift (sim/LawExp.cpp).
+    static V scaleByPow2(V p, V t) {
+        const __m256i whole =
+            _mm256_sub_epi64(_mm256_castpd_si256(t), _mm256_set1_epi64x(lawexp::kShiftBits));
+        const __m256i n1 = _mm256_sub_epi64(
+            _mm256_srli_epi64(_mm256_add_epi64(whole, _mm256_set1_epi64x(2048)), 1),
+            _mm256_set1_epi64x(1024));
+        const __m256i n2 = _mm256_sub_epi64(whole, n1), bias = _mm256_set1_epi64x(1023);
+        const V s1 = _mm256_castsi256_pd(_mm256_slli_epi64(_mm256_add_epi64(n1, bias), 52));
+        const V s2 = _mm256_castsi256_pd(_mm256_slli_epi64(_mm256_add_epi64(n2, bias), 52));
+        return mul(mul(p, s1), s2);
+    }
     static M lt(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
     static M neqOrdered(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_OQ); }
     static M neqUnordered(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
@@ -225,6 +239,18 @@ struct Simd {
     static V max(V a, V b) { return _mm512_max_pd(a, b); }
     static V min(V a, V b) { return _mm512_min_pd(a, b); }
     static M gt(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+    static M ge(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_GE_OQ); }
+    static V scaleByPow2(V p, V t) {
+        const __m512i whole =
+            _mm512_sub_epi64(_mm512_castpd_si512(t), _mm512_set1_epi64(lawexp::kShiftBits));
+        const __m512i n1 =
+            _mm512_sub_epi64(_mm512_srli_epi64(_mm512_add_epi64(whole, _mm512_set1_epi64(2048)), 1),
+                             _mm512_set1_epi64(1024));
+        const __m512i n2 = _mm512_sub_epi64(whole, n1), bias = _mm512_set1_epi64(1023);
+        const V s1 = _mm512_castsi512_pd(_mm512_slli_epi64(_mm512_add_epi64(n1, bias), 52));
+        const V s2 = _mm512_castsi512_pd(_mm512_slli_epi64(_mm512_add_epi64(n2, bias), 52));
+        return mul(mul(p, s1), s2);
+    }
     static M lt(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
     static M neqOrdered(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_OQ); }
     static M neqUnordered(V a, V b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
@@ -301,6 +327,14 @@ double pairsFor(const LinearPairInput& in, const LinearPairOutput& out, int begi
 }  // namespace
 
 bool slotRows() { return simdWidth() == 8; }
+
+void lawExpLanes(const double* x, double* y, int n) {
+#if defined(__x86_64__)
+    if (simdWidth() == 8) return avx512::expLanes(x, y, n);
+    if (simdWidth() == 4) return avx2::expLanes(x, y, n);
+#endif
+    for (int k = 0; k < n; ++k) y[k] = lawExp(x[k]);
+}
 
 double linearPairForces(const LinearPairInput& in, const LinearPairOutput& out, int begin,
                         int end) {

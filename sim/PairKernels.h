@@ -75,6 +75,10 @@ struct LinearPairOutput {
     bool rows = false;  ///< slotRows()
 };
 
+/// y[k] = e^x[k] as the elastoplastic kernel computes it, simdWidth() lanes at a time (the bits
+/// of sim/LawExp.h's lawExp).
+void lawExpLanes(const double* x, double* y, int n);
+
 /// Pairs [begin, end). Dead bonds are computed too: the gather skips them. Returns the power
 /// law's largest look-ahead tangent over c among the living, unbroken, compressed pairs (at
 /// least 1; 1 without a look-ahead).

@@ -1,0 +1,26 @@
+#include "sim/LawExp.h"
+
+#include <bit>
+#include <cmath>
+
+namespace rend::sim {
+
+double lawExp(double x) {
+    using namespace lawexp;
+    if (std::isnan(x)) return x;
+    x = std::min(std::max(x, kLowest), kHighest);
+    const double t = x * kLog2e + kShift;
+    const double n = t - kShift;
+    const double r = (x - n * kLn2Hi) - n * kLn2Lo;
+    double p = kInverseFactorial.c[kTerms];
+    for (int k = kTerms - 1; k >= 0; --k) p = p * r + kInverseFactorial.c[k];
+    // 2^n as 2^n1 2^n2, n1 = floor(n / 2): each a normal number, so that only the last product
+    // rounds (to a subnormal, 0 or infinity where e^x is one).
+    const std::int64_t whole = std::bit_cast<std::int64_t>(t) - kShiftBits;
+    const std::int64_t n1 = std::int64_t(std::uint64_t(whole + 2048) >> 1) - 1024, n2 = whole - n1;
+    const double s1 = std::bit_cast<double>(std::uint64_t(n1 + 1023) << 52);
+    const double s2 = std::bit_cast<double>(std::uint64_t(n2 + 1023) << 52);
+    return p * s1 * s2;
+}
+
+}  // namespace rend::sim

@@ -400,6 +400,9 @@ double Membrane::failureApproachRate() const {
     const MaterialParams& m = params_.material;
     const double delta = params_.time.maxStretchIncrement;
     const bool heated = !theta_.empty();
+    if (const std::optional<double> fast = solver_->failureApproachRate(
+            stepState(), {criticalStretch_, m.expansion, m.strengthLoss, delta}))
+        return domain_ ? domain_->max(*fast) : *fast;
     double fastest = 0.0;  // a maximum: the same for any thread count
 #pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
     for (int i = begin_; i < end_; ++i) {

@@ -95,6 +95,32 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
     return stiffest;
 }
 
+/// One pair's term of Membrane::failureApproachRate (its expressions, in its order), or 0 where
+/// it does not count.
+inline double approachOf(const LinearPairInput& in, const ApproachRate& a, int u) {
+    const int i = in.first[u], j = in.second[u];
+    if (a.pad[u] || i < a.ownBegin || i >= a.ownEnd || !in.alive[in.upper[u]]) return 0.0;
+    const double* x = in.x;
+    const double* v = in.v;
+    const double rx = x[3 * j] - x[3 * i], ry = x[3 * j + 1] - x[3 * i + 1];
+    const double rz = x[3 * j + 2] - x[3 * i + 2];
+    const double rest = in.restLength[u];
+    const double thetaBar = in.theta ? 0.5 * (in.theta[i] + in.theta[j]) : 0.0;
+    const double critical = a.critical * std::max(0.0, 1.0 - a.strengthLoss * thetaBar);
+    const double unstretched = 1.0 + a.expansion * thetaBar;
+    const double loaded = rest * (unstretched + 0.5 * critical);
+    const double squared = rx * rx + ry * ry + rz * rz;
+    if (!(critical > 0.0 && squared > loaded * loaded)) return 0.0;
+    const double length = std::sqrt(squared);
+    const double rate = (rx * (v[3 * j] - v[3 * i]) + ry * (v[3 * j + 1] - v[3 * i + 1]) +
+                         rz * (v[3 * j + 2] - v[3 * i + 2])) /
+                        (length * rest);
+    if (!(rate > 0.0)) return 0.0;
+    const double margin = critical - (length / rest - unstretched);
+    const double value = rate / std::max(0.5 * margin, a.delta * critical);
+    return value > 0.0 ? value : 0.0;  // std::max(fastest, value) keeps fastest for NaN
+}
+
 /// Bit k of `bits` as byte k (0 or 1) of the result: one store for a mask's lanes.
 constexpr std::uint64_t laneBytesOf(unsigned bits) {
     std::uint64_t bytes = 0;
@@ -327,6 +353,20 @@ double pairsFor(const LinearPairInput& in, const LinearPairOutput& out, int begi
 }  // namespace
 
 bool slotRows() { return simdWidth() == 8; }
+
+double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int begin, int end) {
+    double fastest = 0.0;
+#if defined(__x86_64__)
+    if (simdWidth() == 8)
+        begin = in.theta ? avx512::approachSimd<true>(in, a, begin, end, fastest)
+                         : avx512::approachSimd<false>(in, a, begin, end, fastest);
+    else if (simdWidth() == 4)
+        begin = in.theta ? avx2::approachSimd<true>(in, a, begin, end, fastest)
+                         : avx2::approachSimd<false>(in, a, begin, end, fastest);
+#endif
+    for (int u = begin; u < end; ++u) fastest = std::max(fastest, approachOf(in, a, u));
+    return fastest;
+}
 
 void lawExpLanes(const double* x, double* y, int n) {
 #if defined(__x86_64__)

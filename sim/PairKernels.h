@@ -75,6 +75,21 @@ struct LinearPairOutput {
     bool rows = false;  ///< slotRows()
 };
 
+/// Membrane::failureApproachRate's measure: how fast the pairs loaded past half their critical
+/// stretch approach it, ds/dt over the margin left (at least delta eta_c).
+struct ApproachRate {
+    double critical = 0.0;  ///< eta_c: the membrane's, without maps
+    double expansion = 0.0, strengthLoss = 0.0;
+    double delta = 0.0;                 ///< time.max_stretch_increment
+    const std::uint8_t* pad = nullptr;  ///< per pair: a tile's repeat (not counted)
+    int ownBegin = 0, ownEnd = 0;       ///< the pairs counted: their first end in this range
+};
+
+/// The largest rate over pairs [begin, end) that live (in.alive of their upper copy), are not
+/// pads and whose first end is owned; 0 if none. The bits of Membrane's loop over bonds, term by
+/// term (in.x, in.v, in.theta, in.restLength or its classes).
+double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int begin, int end);
+
 /// y[k] = e^x[k] as the elastoplastic kernel computes it, simdWidth() lanes at a time (the bits
 /// of sim/LawExp.h's lawExp).
 void lawExpLanes(const double* x, double* y, int n);

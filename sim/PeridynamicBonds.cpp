@@ -581,6 +581,30 @@ void PeridynamicBonds::advance(const StepState& s, Workspace& work,
     if (law_.kind == BondLawKind::PowerLaw) stiffening_ = updates.stiffest;
 }
 
+// The vectorised pass's pairs, each bond once through its upper copy, as Membrane's loop takes
+// them (j > i, living, i this process's).
+std::optional<double> PeridynamicBonds::failureApproachRate(const StepState& s,
+                                                            const FailureApproach& f) const {
+    if (!vectorised() || s.v.empty()) return std::nullopt;
+    LinearPairInput in = pairInput(s, false, false);
+    in.v = s.v.data()->data();
+    const ApproachRate a{f.criticalStretch, f.expansion, f.strengthLoss, f.maxStretchIncrement,
+                         pairPad_.data(),   slab_.begin, slab_.end};
+    const int n = bonds_.particleCount(), first = pairsBefore(tileStart(slab_.begin));
+    const int last = pairsBefore(slab_.end);
+    double fastest = 0.0;  // a maximum: the same for any thread count
+#pragma omp parallel if (n >= kParallelThreshold) reduction(max : fastest)
+    {
+        const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+        const std::int64_t span = last - first;
+        const int from = first + kTile * int(span / kTile * t / threads);
+        const int to =
+            t + 1 == threads ? last : first + kTile * int(span / kTile * (t + 1) / threads);
+        fastest = std::max(fastest, pairApproachRate(in, a, from, to));
+    }
+    return fastest;
+}
+
 void PeridynamicBonds::reportStrength(DamageState& damage) const {
     syncHistory();
     for (std::size_t b = 0; b < plastic_.size(); ++b)

@@ -58,6 +58,8 @@ public:
         heldAhead_ = false, heldBehind_ = true;
     }
     void reportStrength(DamageState& damage) const override;
+    std::optional<double> failureApproachRate(const StepState& s,
+                                              const FailureApproach& f) const override;
     bool restrictTo(const Slab& slab) override {
         slab_ = slab;
         return true;

@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,6 +38,13 @@ struct StepState {
     std::span<const Eigen::Vector3d> v;  ///< velocities; empty where only forces are asked
     std::span<const double> theta;       ///< the diffusing quantity; empty without diffusion
     double dt = 0.0;                     ///< the step about to be taken [s]
+};
+
+/// What Membrane::failureApproachRate measures a step by (its constants).
+struct FailureApproach {
+    double criticalStretch = 0.0;  ///< the membrane's eta_c, without maps
+    double expansion = 0.0, strengthLoss = 0.0;
+    double maxStretchIncrement = 0.0;
 };
 
 /// What a solver that carries momentum through a grid (Solver::transferMomentum) reads.
@@ -97,6 +105,13 @@ public:
     /// the solver keeps in its own pieces (springs, elements); called once per frame, for the
     /// damage field. Nothing by default: every bond keeps full strength.
     virtual void reportStrength(DamageState& damage) const {}
+    /// Membrane::failureApproachRate over this process's particles' bonds by the solver's own
+    /// pair loop, where it has one: the same value, bit for bit. None by default (Membrane's
+    /// loop over its bonds).
+    virtual std::optional<double> failureApproachRate(const StepState& s,
+                                                      const FailureApproach& f) const {
+        return std::nullopt;
+    }
     /// The solver's own history (plastic strains, broken pieces) for a checkpoint
     /// (sim/StateArchive.h), read back into a solver built from the same scene. Nothing by
     /// default: a solver without history keeps it all in the DamageState.

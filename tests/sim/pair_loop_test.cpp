@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <bit>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "sim/Domain.h"
@@ -225,6 +227,75 @@ TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {
         }
         EXPECT_EQ(differ, 0) << "amplitude " << amplitude;
         EXPECT_GT(grew, 100) << "the test yields bonds";
+    }
+}
+
+/// Membrane::failureApproachRate's loop over bonds, as written there.
+double approachOverBonds(const BondFamilies& bonds, const DamageState& damage,
+                         const FailureApproach& f, const std::vector<Eigen::Vector3d>& x,
+                         const std::vector<Eigen::Vector3d>& v, const std::vector<double>& theta) {
+    double fastest = 0.0;
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            const int j = bonds.partners[b];
+            if (j < i || !damage.bondAlive()[b]) continue;
+            const Eigen::Vector3d xi = x[j] - x[i];
+            const double rest = bonds.restLength[b];
+            const double thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[i] + theta[j]);
+            const double critical = f.criticalStretch * degradation(f.strengthLoss, thetaBar);
+            const double unstretched = 1.0 + f.expansion * thetaBar;
+            const double loaded = rest * (unstretched + 0.5 * critical);
+            if (!(critical > 0.0 && xi.squaredNorm() > loaded * loaded)) continue;
+            const double length = xi.norm();
+            const double rate = xi.dot(v[j] - v[i]) / (length * rest);
+            if (!(rate > 0.0)) continue;
+            const double margin = critical - (length / rest - unstretched);
+            fastest =
+                std::max(fastest, rate / std::max(0.5 * margin, f.maxStretchIncrement * critical));
+        }
+    return fastest;
+}
+
+// The solver's pairs give Membrane's failure approach rate bit for bit (the adaptive step's
+// measure), on both lattices, with theta, dead bonds and 1 or 3 threads.
+TEST(PairLoop, TheFailureApproachRateIsMembranesLoopOverBonds) {
+    for (const LatticeKind kind : {LatticeKind::Square, LatticeKind::Hexagonal}) {
+        MembraneParams p = SmallSheet::params(BondLawKind::Linear);
+        p.sheet.lattice = kind;
+        p.sheet.size = {1.0, 0.5};  // over the threads' threshold
+        SmallSheet sheet(p);
+        auto& [params, lattice, bonds, volumes, solver, damage] = sheet;
+        for (int b = 0; b < int(bonds.directedCount()); b += 31) damage.breakBond(b);
+        const int n = int(lattice.positions.size());
+        std::vector<Eigen::Vector3d> x = lattice.positions, v(n);
+        std::vector<double> theta(n);
+        FailureApproach f{0.01, 0.02, 0.3, 0.05};
+        for (int i = 0; i < n; ++i) {  // strains up to 2 eta_c, some bonds opening fast
+            for (int a = 0; a < 3; ++a) {
+                x[i][a] += 0.02 * p.sheet.dx * (2.0 * uniformFromHash(31, 3 * i + a) - 1.0);
+                v[i][a] = 2.0 * uniformFromHash(32, 3 * i + a) - 1.0;
+            }
+            theta[i] = 1.5 * uniformFromHash(33, i);
+        }
+        const int before = omp_get_max_threads();
+        // The margin's floor: what most lanes take, what the fastest takes, what all take.
+        for (const double delta : {0.05, 1e-4, 10.0})
+            for (const bool heated : {false, true}) {
+                f.maxStretchIncrement = delta;
+                const std::vector<double> t = heated ? theta : std::vector<double>{};
+                const double expected = approachOverBonds(bonds, damage, f, x, v, t);
+                EXPECT_GT(expected, 0.0);
+                for (const int threads : {1, 3}) {
+                    omp_set_num_threads(threads);
+                    const std::optional<double> got =
+                        solver.failureApproachRate({x, v, t, 1e-5}, f);
+                    ASSERT_TRUE(got.has_value());
+                    EXPECT_EQ(std::bit_cast<std::uint64_t>(*got),
+                              std::bit_cast<std::uint64_t>(expected))
+                        << *got << " against " << expected << ", " << threads << " threads";
+                }
+            }
+        omp_set_num_threads(before);
     }
 }
 

@@ -208,9 +208,8 @@ struct Lanes3 {
     }
 }
 
-/// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
-/// group (a group without rows one particle at a time, after the tile's store).
-/// A row's x (or y, z: `at` after) of all eight lanes, from one run or two.
+/// A row's x (or y, z: `at` after) of all eight lanes, from one run or two: plain loads (a ring
+/// has kPairTile readable doubles before and after it) and a blend.
 [[REND_TILE_TARGET]] inline __m512d wholeRow(const double* a, const double* b, __mmask8 fromA,
                                              int at) {
     if (fromA == 0xff) return _mm512_loadu_pd(a + at);
@@ -250,6 +249,8 @@ template <int kBonds>
     storeParticles(out, x, y, z);
 }
 
+/// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
+/// group (a group without rows one particle at a time, after the tile's store).
 [[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t) {
     if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]]; one.endLane == kTile) {
         const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;

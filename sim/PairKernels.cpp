@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "sim/BondLaw.h"
 #include "sim/LawExp.h"
@@ -121,6 +122,23 @@ inline double approachOf(const LinearPairInput& in, const ApproachRate& a, int u
     return value > 0.0 ? value : 0.0;  // std::max(fastest, value) keeps fastest for NaN
 }
 
+/// The look-ahead strain (1 + it is eq. 19's s) at or above which a compressed pair cannot raise
+/// the largest tangent so far, `stiffest` (over c with theta, else its numerator; the kernels'
+/// stiffestSoFar); infinity where every compressed pair may. For 0 < s < 1 the numerator is at most
+/// 2C (1 + 3 / s^4) + max(C* n (n - 1), 0) (s^(n-2) <= 1 for the whole exponents n - 2 >= 0
+/// wholePower() takes), falling in s: below the s where that bound equals `stiffest`, with a
+/// margin far above the rounding of either side. With theta the tangent is the numerator over c
+/// times a stiffness of at most 1.
+inline double lookAheadReach(const LinearPairInput& in, double stiffest, bool theta) {
+    constexpr double kEverywhere = std::numeric_limits<double>::infinity();
+    const double starNN = std::max(in.powerCStar * in.powerN * (in.powerN - 1.0), 0.0);
+    if (!(in.powerC > 0.0) || !(starNN <= 1e4 * in.powerC) || in.powerN < 2.0) return kEverywhere;
+    const double numerator = theta ? stiffest * in.c : stiffest;
+    const double t = (numerator - starNN) / (2.0 * in.powerC) - 1.0;  // 3 / s^4 where equal
+    if (!(t > 0.0)) return kEverywhere;
+    return std::sqrt(std::sqrt(3.0 / t)) - 1.0 + 1e-7;
+}
+
 /// Bit k of `bits` as byte k (0 or 1) of the result: one store for a mask's lanes.
 constexpr std::uint64_t laneBytesOf(unsigned bits) {
     std::uint64_t bytes = 0;
@@ -182,6 +200,7 @@ struct Simd {
     static M noLanes() { return _mm256_setzero_pd(); }
     static M andNot(M a, M b) { return _mm256_andnot_pd(a, b); }  ///< not a, and b
     static M both(M a, M b) { return _mm256_and_pd(a, b); }
+    static M either(M a, M b) { return _mm256_or_pd(a, b); }
     static V blend(V a, V b, M m) { return _mm256_blendv_pd(a, b, m); }  ///< m ? b : a
     static unsigned bits(M m) { return unsigned(_mm256_movemask_pd(m)); }
     static M maskOf(unsigned bits) {
@@ -283,6 +302,7 @@ struct Simd {
     static M noLanes() { return 0; }
     static M andNot(M a, M b) { return M(~a & b); }
     static M both(M a, M b) { return M(a & b); }
+    static M either(M a, M b) { return M(a | b); }
     static V blend(V a, V b, M m) { return _mm512_mask_blend_pd(m, a, b); }
     static unsigned bits(M m) { return m; }
     static M maskOf(unsigned bits) { return M(bits); }

@@ -217,6 +217,11 @@ struct Simd {
         return _mm256_i32gather_pd(base, _mm_loadu_si128(reinterpret_cast<const __m128i*>(index)),
                                    8);
     }
+    /// Four 16-bit counts from p as doubles.
+    [[gnu::always_inline]] static V countsAsDoubles(const std::uint16_t* p) {
+        return _mm256_cvtepi32_pd(
+            _mm_cvtepu16_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+    }
     /// The x, y and z of four consecutive particles from p (the first's x): three loads.
     [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {
         const V a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
@@ -315,6 +320,11 @@ struct Simd {
     [[gnu::always_inline]] static V gather(const double* base, const int* index) {
         return _mm512_i32gather_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)),
                                    base, 8);
+    }
+    /// Eight 16-bit counts from p as doubles.
+    [[gnu::always_inline]] static V countsAsDoubles(const std::uint16_t* p) {
+        return _mm512_cvtepi32_pd(
+            _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))));
     }
     /// Eight consecutive particles' x, y and z from p (sim/SimdRuns.h).
     [[gnu::always_inline]] static void loadRun(const double* p, V& x, V& y, V& z) {

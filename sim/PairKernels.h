@@ -45,13 +45,17 @@ struct LinearPairInput {
     double* held = nullptr;
     /// Per kPairTile pairs from a multiple of it (a vector, or two): where their ends are runs
     /// of consecutive particles, the first of each run (else -1); where their rest lengths,
-    /// bond scales and limits are each one value, its class in the tables (else -1). Such
-    /// vectors read none of the per-pair arrays above but upper and twin.
+    /// bond scales and limits are each one value, its class c >= 0 in the tables; where each is
+    /// its class's value plus whole steps of its unit (16 bits per pair, restSteps...),
+    /// kSteppedClass - c; else -1. Classed vectors read none of the per-pair doubles above.
     const int* runFirst = nullptr;
     const int* runSecond = nullptr;
     const int* uniform = nullptr;
     const double *classRest = nullptr, *classScale = nullptr, *classLimit = nullptr;
+    const double *classRestUnit = nullptr, *classScaleUnit = nullptr, *classLimitUnit = nullptr;
+    const std::uint16_t *restSteps = nullptr, *scaleSteps = nullptr, *limitSteps = nullptr;
 };
+inline constexpr int kSteppedClass = -2;
 
 /// Where a pair's force lies in its slots. In rows (eight lanes wide, sim/PairSums.h's tile
 /// sums): rows of kPairTile slots, the x of the row's pairs, then their y, then their z, so that

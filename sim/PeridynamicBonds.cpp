@@ -116,36 +116,74 @@ void PeridynamicBonds::setUpPairArrays() {
 }
 
 // Per row of a tile (its particles' k-th pairs, side by side): whether its ends are two runs of
-// consecutive particles, and whether its rest lengths, scales and limits are one value each, to
-// the bit (then the kernels read them once, from the classes' tables). On a regular lattice
-// almost every row is both, and the per-pair arrays stay in memory unread.
+// consecutive particles, and whether its rest lengths, scales and limits are each one value to
+// the bit, or one value plus whole steps of its last bit. Far from the origin a lattice's
+// coordinates carry rounding, so the bonds of one direction differ in their last bits (on a
+// 20 m sheet at dx 0.02, three rows in four): as a row's smallest value and 16 bits per pair (v =
+// smallest + steps * unit, exact: steps * unit is a multiple of the smallest's last bit and the
+// sum is v itself), the kernels read two bytes per pair where they read eight, with the same bits.
+// On a regular lattice almost every row is a class, and the per-pair arrays stay in memory unread.
 void PeridynamicBonds::setUpPairRows() {
     const int rows = int(pairFirst_.size()) / kTile;
     rowRunFirst_.assign(rows, -1), rowRunSecond_.assign(rows, -1), rowClass_.assign(rows, -1);
     classRest_.clear(), classScale_.clear(), classLimit_.clear();
-    const auto bitsOf = [&](int u) {
-        return std::array<std::uint64_t, 3>{std::bit_cast<std::uint64_t>(pairRest_[u]),
-                                            std::bit_cast<std::uint64_t>(pairScale_[u]),
-                                            std::bit_cast<std::uint64_t>(pairLimit_[u])};
-    };
+    classRestUnit_.clear(), classScaleUnit_.clear(), classLimitUnit_.clear();
+    pairRestSteps_.assign(pairFirst_.size(), 0), pairScaleSteps_.assign(pairFirst_.size(), 0);
+    pairLimitSteps_.assign(pairFirst_.size(), 0);
     std::map<std::array<std::uint64_t, 3>, int> classes;
     for (int row = 0; row < rows; ++row) {
         const int u = kTile * row;
-        bool run = true, same = true;
-        for (int k = 1; k < kTile; ++k) {
+        bool run = true;
+        for (int k = 1; k < kTile; ++k)
             run = run && pairFirst_[u + k] == pairFirst_[u] + k &&
                   pairSecond_[u + k] == pairSecond_[u] + k;
-            same = same && bitsOf(u + k) == bitsOf(u);
-        }
         if (run) rowRunFirst_[row] = pairFirst_[u], rowRunSecond_[row] = pairSecond_[u];
-        if (!same) continue;
-        const auto [at, added] = classes.try_emplace(bitsOf(u), int(classRest_.size()));
+        const std::optional<RowSteps> rest = rowSteps(&pairRest_[u], &pairRestSteps_[u]);
+        const std::optional<RowSteps> scale = rowSteps(&pairScale_[u], &pairScaleSteps_[u]);
+        const std::optional<RowSteps> limit = rowSteps(&pairLimit_[u], &pairLimitSteps_[u]);
+        if (!rest || !scale || !limit) continue;
+        const std::array<std::uint64_t, 3> key{std::bit_cast<std::uint64_t>(rest->smallest),
+                                               std::bit_cast<std::uint64_t>(scale->smallest),
+                                               std::bit_cast<std::uint64_t>(limit->smallest)};
+        const auto [at, added] = classes.try_emplace(key, int(classRest_.size()));
         if (added) {
-            classRest_.push_back(pairRest_[u]), classScale_.push_back(pairScale_[u]);
-            classLimit_.push_back(pairLimit_[u]);
+            classRest_.push_back(rest->smallest), classScale_.push_back(scale->smallest);
+            classLimit_.push_back(limit->smallest), classRestUnit_.push_back(rest->unit);
+            classScaleUnit_.push_back(scale->unit), classLimitUnit_.push_back(limit->unit);
         }
-        rowClass_[row] = at->second;
+        const bool exact = !rest->stepped && !scale->stepped && !limit->stepped;
+        rowClass_[row] = exact ? at->second : kSteppedClass - at->second;
     }
+}
+
+PeridynamicBonds::RowClasses PeridynamicBonds::rowClasses() const {
+    RowClasses r;
+    for (const int c : rowClass_) (c >= 0 ? r.exact : c == -1 ? r.perPair : r.stepped) += 1;
+    return r;
+}
+
+// A row's kTile values as its smallest plus steps (0-65535) of the smallest's last bit, each
+// checked to give the value's bits; nothing where one does not (NaN, values far apart).
+std::optional<PeridynamicBonds::RowSteps> PeridynamicBonds::rowSteps(const double* values,
+                                                                     std::uint16_t* steps) {
+    RowSteps r{*std::min_element(values, values + kTile), 0.0, false};
+    if (std::isfinite(r.smallest) && r.smallest != 0.0)
+        r.unit = std::ldexp(1.0, std::ilogb(r.smallest) - std::numeric_limits<double>::digits + 1);
+    std::uint16_t found[kTile];
+    for (int k = 0; k < kTile; ++k) {
+        if (std::bit_cast<std::uint64_t>(values[k]) == std::bit_cast<std::uint64_t>(r.smallest)) {
+            found[k] = 0;
+            continue;
+        }
+        const double count = r.unit > 0.0 ? std::round((values[k] - r.smallest) / r.unit) : -1.0;
+        if (!(count >= 1.0 && count <= 65535.0)) return std::nullopt;
+        const double back = r.smallest + count * r.unit;  // the kernels' expression
+        if (std::bit_cast<std::uint64_t>(back) != std::bit_cast<std::uint64_t>(values[k]))
+            return std::nullopt;
+        found[k] = std::uint16_t(count), r.stepped = true;
+    }
+    std::copy(found, found + kTile, steps);
+    return r;
 }
 
 std::unique_ptr<Solver> PeridynamicBonds::make(const SolverSetUp& s) {
@@ -443,6 +481,10 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.uniform = rowClass_.data();
     in.classRest = classRest_.data(), in.classScale = classScale_.data();
     in.classLimit = classLimit_.data();
+    in.classRestUnit = classRestUnit_.data(), in.classScaleUnit = classScaleUnit_.data();
+    in.classLimitUnit = classLimitUnit_.data();
+    in.restSteps = pairRestSteps_.data(), in.scaleSteps = pairScaleSteps_.data();
+    in.limitSteps = pairLimitSteps_.data();
     return in;
 }
 

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -49,6 +50,12 @@ public:
     std::vector<double> stiffnessRowSums(int particleCount) const override;
     double strainEnergy(const StepState& s, Workspace& work) const override;
     double stiffening() const override { return stiffening_; }
+    /// How many rows of the vectorised pass's pairs have one rest length, scale and limit to the
+    /// bit, one plus whole steps of its last bit per pair, or neither (setUpPairRows).
+    struct RowClasses {
+        int exact = 0, stepped = 0, perPair = 0;
+    };
+    RowClasses rowClasses() const;
     void saveState(StateWriter& out) const override {
         syncHistory();
         out(plastic_), out(stiffening_);
@@ -147,11 +154,18 @@ private:
     std::vector<std::uint8_t> pairPad_;
     std::vector<double> pairRest_, pairScale_, pairLimit_;
     /// Per row of kTile pairs (setUpPairRows): the first particles of its ends' runs (-1: not
-    /// runs), and the class of its one rest length, scale and limit (-1: not one); per class,
-    /// those values.
+    /// runs), and the class of its rest lengths, scales and limits (LinearPairInput::uniform);
+    /// per class, its smallest values and their last bits; per pair, its steps of those.
     std::vector<int> rowRunFirst_, rowRunSecond_, rowClass_;
     std::vector<double> classRest_, classScale_, classLimit_;
+    std::vector<double> classRestUnit_, classScaleUnit_, classLimitUnit_;
+    std::vector<std::uint16_t> pairRestSteps_, pairScaleSteps_, pairLimitSteps_;
     void setUpPairRows();
+    struct RowSteps {
+        double smallest, unit;
+        bool stepped;  ///< some value is not the smallest
+    };
+    static std::optional<RowSteps> rowSteps(const double* values, std::uint16_t* steps);
     PairSumTiles sumTiles_;  ///< the tiles whose sums run eight lanes wide (sim/PairSums.h)
     /// The first pair of the tile starting at particle p (a tile's first, or the particle count).
     int pairsBefore(int p) const { return tileBegin_[(p + kTile - 1) / kTile]; }

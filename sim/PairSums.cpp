@@ -2,8 +2,11 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
+#include <fstream>
+#include <string>
 
 #include "sim/PairKernels.h"
 #include "sim/StepKernels.h"
@@ -165,13 +168,19 @@ constexpr Interleave kInterleave = [] {
     return m;
 }();
 
-[[REND_TILE_TARGET]] inline void storeParticles(double* out, __m512d x, __m512d y, __m512d z) {
+/// Eight particles' x y z from their lanes: three stores, around the caches where `stream`
+/// (out then lies on a 64-byte line).
+[[REND_TILE_TARGET]] inline void storeParticles(double* out, __m512d x, __m512d y, __m512d z,
+                                                bool stream) {
     for (int part = 0; part < 3; ++part) {
         const __m512d xy =
             _mm512_permutex2var_pd(x, _mm512_loadu_si512(kInterleave.fromXY[part]), y);
-        _mm512_storeu_pd(out + 8 * part, _mm512_mask_permutexvar_pd(
-                                             xy, __mmask8(kInterleave.isZ[part]),
-                                             _mm512_loadu_si512(kInterleave.fromZ[part]), z));
+        const __m512d three = _mm512_mask_permutexvar_pd(
+            xy, __mmask8(kInterleave.isZ[part]), _mm512_loadu_si512(kInterleave.fromZ[part]), z);
+        if (stream)
+            _mm512_stream_pd(out + 8 * part, three);
+        else
+            _mm512_storeu_pd(out + 8 * part, three);
     }
 }
 
@@ -221,7 +230,7 @@ struct Lanes3 {
 /// compiled for each count of bonds, so that its loop unrolls.
 template <int kBonds>
 [[REND_TILE_TARGET]] void sumWholeTile(const PairGather& g, const PairSumTiles::Row* row, int lower,
-                                       const std::uint8_t* alive, double* out) {
+                                       const std::uint8_t* alive, double* out, bool stream) {
     constexpr __mmask64 kFlags =
         kBonds == kTile ? ~__mmask64(0) : (__mmask64(1) << (kTile * kBonds)) - 1;
     constexpr std::uint64_t kStride = [] {  // bit 0 of each lane's flags
@@ -246,21 +255,21 @@ template <int kBonds>
             z = _mm512_mask_add_pd(z, on, z, fz);
         }
     }
-    storeParticles(out, x, y, z);
+    storeParticles(out, x, y, z, stream);
 }
 
 /// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
 /// group (a group without rows one particle at a time, after the tile's store).
-[[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t) {
+[[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t, bool stream) {
     if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]]; one.endLane == kTile) {
         const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
         const std::uint8_t* alive = g.alive + g.offsets[kTile * t];
         double* out = g.force + 3 * kTile * std::size_t(t);
         switch (one.bonds) {  // the square lattice's 8 and the hexagonal lattice's 6
             case 8:
-                return sumWholeTile<8>(g, rows, one.lower, alive, out);
+                return sumWholeTile<8>(g, rows, one.lower, alive, out, stream);
             case 6:
-                return sumWholeTile<6>(g, rows, one.lower, alive, out);
+                return sumWholeTile<6>(g, rows, one.lower, alive, out, stream);
             default:
                 break;
         }
@@ -283,15 +292,17 @@ template <int kBonds>
             addRow(g, s, group.rowFirst + k, first, __mmask8(mask), life.of(k) << first, false,
                    sum);
     }
-    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z);
+    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z, stream);
     for (; alone != 0; alone &= alone - 1) gatherParticle(g, kTile * t + std::countr_zero(alone));
 }
 
 [[REND_TILE_TARGET]] void gatherTiles(const PairGather& g, int begin, int end) {
     int i = begin;
     for (; i < end && i % kTile != 0; ++i) gatherParticle(g, i);
-    for (; i + kTile <= end; i += kTile) sumTile(g, *g.tiles, i / kTile);
+    const bool stream = writesAround(g);
+    for (; i + kTile <= end; i += kTile) sumTile(g, *g.tiles, i / kTile, stream);
     for (; i < end; ++i) gatherParticle(g, i);
+    if (stream) _mm_sfence();  // the streamed stores before any other thread's reads
 }
 
 // A pair force is one four-lane load (x y z 0 slots); the lanes add as the scalar sums do.
@@ -332,6 +343,35 @@ void gatherPairForces(const PairGather& g, int begin, int end) {
     }
 #endif
     gatherLoop(g, begin, end);
+}
+
+bool writesAround(const PairGather& g) {
+    return g.stream && g.rows && g.tiles && simdWidth() == 8 &&
+           reinterpret_cast<std::uintptr_t>(g.force) % 64 == 0;
+}
+
+bool streamsForces(long long particles) {
+    constexpr long long kStepBytes = 256;  // per particle
+    static const long long cache = lastLevelCacheBytes();
+    return particles * kStepBytes > cache;
+}
+
+// The largest cache the kernel lists for CPU 0 (what lscpu prints: the L3 this core shares),
+// else 32 MiB. glibc's sysconf(_SC_LEVEL3_CACHE_SIZE) can report the whole package's (384 MiB
+// on this VM's EPYC, against 32 MiB per core complex).
+long long lastLevelCacheBytes() {
+    long long largest = 0;
+    for (int index = 0; index < 8; ++index) {
+        std::ifstream file("/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) +
+                           "/size");
+        long long size = 0;
+        char unit = 0;
+        if (!(file >> size)) break;
+        file >> unit;
+        const long long bytes = unit == 'K' ? size << 10 : unit == 'M' ? size << 20 : size;
+        largest = std::max(largest, bytes);
+    }
+    return largest > 0 ? largest : 32ll << 20;
 }
 
 }  // namespace rend::sim

@@ -544,7 +544,8 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                           force.data()->data(),
                           unsigned(ringPairs_ - 1),
                           &sumTiles_,
-                          rows};
+                          rows,
+                          streamsForces(slab_.end - slab_.ghostBegin)};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
             stiffest = std::max(stiffest, compute(in, p, q));

@@ -13,6 +13,7 @@
 #include "sim/PairKernels.h"
 #include "sim/PairSums.h"
 #include "sim/Random.h"
+#include "sim/StepKernels.h"
 
 using namespace rend::sim;
 
@@ -67,20 +68,28 @@ struct Sums {
             alive[b] = draw < 0.1 ? 0 : draw < 0.2 ? 2 : 1;
         }
     }
-    /// The sums of particles [begin, end), with or without the tiles.
-    std::vector<double> of(int begin, int end, bool withTiles) const {
-        std::vector<double> force(3 * bonds.particleCount(), -7.0);
+    /// The sums of particles [begin, end), with or without the tiles, with their stores
+    /// around the caches or not.
+    std::vector<double> of(int begin, int end, bool withTiles, bool stream = false) const {
+        const std::size_t size = 3 * std::size_t(bonds.particleCount());
+        std::vector<double> buffer(size + 8, -7.0);
+        double* force = buffer.data();  // on a 64-byte line, as streamed stores need
+        while (reinterpret_cast<std::uintptr_t>(force) % 64 != 0) ++force;
         const PairGather g{bonds.offsets.data(),
                            pairs.upperBegin.data(),
                            pairOf.data(),
                            alive.data(),
                            slots.data() + kTile,
-                           force.data(),
+                           force,
                            slotMask,
                            withTiles ? &tiles : nullptr,
-                           true};
+                           true,
+                           stream};
+        if (stream && withTiles && simdWidth() == 8) {
+            EXPECT_TRUE(writesAround(g));
+        }
         gatherPairForces(g, begin, end);
-        return force;
+        return std::vector<double>(force, force + size);
     }
     const BondFamilies& bonds;
     BondPairs pairs;
@@ -95,6 +104,9 @@ void expectSameBits(const Sums& sums, int begin, int end) {
     const std::vector<double> alone = sums.of(begin, end, false), tiled = sums.of(begin, end, true);
     EXPECT_EQ(std::memcmp(alone.data(), tiled.data(), alone.size() * sizeof(double)), 0)
         << "particles " << begin << " to " << end;
+    const std::vector<double> streamed = sums.of(begin, end, true, true);
+    EXPECT_EQ(std::memcmp(alone.data(), streamed.data(), alone.size() * sizeof(double)), 0)
+        << "particles " << begin << " to " << end << ", stored around the caches";
 }
 
 struct Case {

@@ -4,9 +4,19 @@
 // the whole step is about 3% faster (10.2 -> 9.9 ns per particle-step at 10^4 particles,
 // 16.9 -> 16.6 at 10^6); the arithmetic, and so every bit of the state, is the same.
 //
+// Allocations of 4 MiB or more (the particle and pair arrays past 10^5 particles) start on a
+// 2 MiB boundary and ask for transparent huge pages over their whole 2 MiB pages
+// (madvise(MADV_HUGEPAGE): Debian's default THP setting is "madvise"). A step past the caches
+// streams every array once; in 4 KiB pages each array crosses a page every 170 particles, each a
+// TLB miss and a fresh start for the hardware prefetcher. 1,002,001 particles, interleaved:
+// 12.0 -> 11.9 ns on one thread, 6.8 -> 6.5 on two. Where the system refuses, the pages are
+// small as before.
+//
 // The replaceable global operator new, in the rend program and the programs that link
 // rend_app (its benchmarks); the library's small allocations are left to malloc as they were.
 // operator delete pairs with it through free(), which takes memory from either.
+
+#include <sys/mman.h>
 
 #include <cstdlib>
 #include <new>
@@ -15,11 +25,17 @@ namespace {
 
 constexpr std::size_t kAlignedFrom = 4096;
 constexpr std::size_t kLine = 64;
+constexpr std::size_t kHugePage = std::size_t(2) << 20, kHugeFrom = std::size_t(4) << 20;
 
 }  // namespace
 
 void* operator new(std::size_t bytes) {
     void* p = nullptr;
+    if (bytes >= kHugeFrom) {
+        if (posix_memalign(&p, kHugePage, bytes) != 0) throw std::bad_alloc();
+        madvise(p, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);  // a hint: failure is fine
+        return p;
+    }
     if (bytes >= kAlignedFrom) {
         if (posix_memalign(&p, kLine, bytes) != 0) throw std::bad_alloc();
         return p;

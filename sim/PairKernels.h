@@ -38,6 +38,7 @@ struct LinearPairInput {
     const double* v = nullptr;
     double dt = 0.0;
     const std::uint8_t* alive = nullptr;  ///< per directed bond
+    bool allAlive = false;                ///< no bond has broken: every alive flag is 1
     const int* upper = nullptr;           ///< per pair: its upper copy
     const int* twin = nullptr;            ///< per pair: its lower copy
     /// Per pair (elastoplastic): the largest strain its bond has reached (BondLaw's
@@ -54,6 +55,9 @@ struct LinearPairInput {
     const double *classRest = nullptr, *classScale = nullptr, *classLimit = nullptr;
     const double *classRestUnit = nullptr, *classScaleUnit = nullptr, *classLimitUnit = nullptr;
     const std::uint16_t *restSteps = nullptr, *scaleSteps = nullptr, *limitSteps = nullptr;
+    /// How many particles ahead of a tile's first the kernels prefetch x (0: none), and how
+    /// many particles x holds.
+    int prefetchAhead = 0, particles = 0;
 };
 inline constexpr int kSteppedClass = -2;
 

@@ -466,6 +466,7 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.update = update;
     in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
+    in.allAlive = damage_->brokenBondCount() == 0;
     in.twin = pairTwin_.data();
     if (!plastic_.empty()) {
         if (heldBehind_) {
@@ -478,6 +479,8 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
         heldAhead_ = heldAhead_ || update;
     }
     in.runFirst = rowRunFirst_.data(), in.runSecond = rowRunSecond_.data();
+    // Past the furthest partner, by about 24 KiB of positions (512 to 4,096 measured alike).
+    in.prefetchAhead = reach_ + 1024, in.particles = int(s.x.size());
     in.uniform = rowClass_.data();
     in.classRest = classRest_.data(), in.classScale = classScale_.data();
     in.classLimit = classLimit_.data();

@@ -296,7 +296,8 @@ template <int kBonds>
     for (; alone != 0; alone &= alone - 1) gatherParticle(g, kTile * t + std::countr_zero(alone));
 }
 
-[[REND_TILE_TARGET]] void gatherTiles(const PairGather& g, int begin, int end) {
+[[REND_TILE_TARGET]] void gatherTiles(const PairGather& input, int begin, int end) {
+    const PairGather g = input;  // its own copy: the force stores cannot alias it
     int i = begin;
     for (; i < end && i % kTile != 0; ++i) gatherParticle(g, i);
     const bool stream = writesAround(g);

@@ -134,8 +134,9 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 
 // Eight free particles are twenty-four doubles, three lanes of eight, the masses and gravity
 // spread by permutes.
-[[gnu::target("avx2,avx512f")]] int kickDriftAvx512(const KickDrift& k, int begin, int end,
+[[gnu::target("avx2,avx512f")]] int kickDriftAvx512(const KickDrift& input, int begin, int end,
                                                     bool& below) {
+    const KickDrift k = input;  // its own copy: the stores to x and v cannot alias it
     const __m512d h = _mm512_set1_pd(k.h), dt = _mm512_set1_pd(k.dt);
     const __m512d damping = _mm512_set1_pd(k.damping), floor = _mm512_set1_pd(k.floor);
     const __m512d g = _mm512_setr_pd(k.gravity[0], k.gravity[1], k.gravity[2], 0, 0, 0, 0, 0);

@@ -56,7 +56,9 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             double limit = in.limit[u];
             if constexpr (kTheta) limit *= std::max(0.0, 1.0 - in.strengthLoss * thetaBar);
             past = eta > limit;
-            over[u] = past;
+            const unsigned bit = unsigned(u) % kPairTile;
+            std::uint8_t& row = over[u / kPairTile];
+            row = std::uint8_t((bit == 0 ? 0u : row & ~(1u << bit)) | unsigned(past) << bit);
         }
         if constexpr (kLaw == BondLawKind::PowerLaw) {  // eq. 19, and the tangent in dt
             if (kUpdate && eta < 0.0 && !past && in.alive[in.upper[u]]) {
@@ -138,19 +140,6 @@ inline double lookAheadReach(const LinearPairInput& in, double stiffest, bool th
     if (!(t > 0.0)) return kEverywhere;
     return std::sqrt(std::sqrt(3.0 / t)) - 1.0 + 1e-7;
 }
-
-/// Bit k of `bits` as byte k (0 or 1) of the result: one store for a mask's lanes.
-constexpr std::uint64_t laneBytesOf(unsigned bits) {
-    std::uint64_t bytes = 0;
-    for (int k = 0; k < 8; ++k) bytes |= std::uint64_t((bits >> k) & 1u) << (8 * k);
-    return bytes;
-}
-constexpr auto kLaneBytes = [] {
-    std::array<std::uint64_t, 256> table{};
-    for (unsigned bits = 0; bits < 256; ++bits) table[bits] = laneBytesOf(bits);
-    return table;
-}();
-inline std::uint64_t laneBytes(unsigned bits) { return kLaneBytes[bits & 255u]; }
 
 #if defined(__x86_64__)
 // Each width's code is compiled for its instruction set: GCC by `#pragma GCC target`, clang (the

@@ -78,7 +78,9 @@ struct LinearPairOutput {
     /// Pair u's force on i at slotAt(u - slotBase, rows): zero past its limit. slotBase is a
     /// multiple of kPairTile.
     double* force = nullptr;
-    std::uint8_t* over = nullptr;  ///< per pair: past its limit (only with a limit)
+    /// Per row of kPairTile pairs (only with a limit): bit u % kPairTile of byte u / kPairTile,
+    /// pair u is past its limit. The kernels take rows whole: begin is a multiple of kPairTile.
+    std::uint8_t* over = nullptr;
     int slotBase = 0;
     bool rows = false;  ///< slotRows()
 };

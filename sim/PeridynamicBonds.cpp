@@ -505,7 +505,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     const std::size_t ringSize =
         rows ? 2 * kPairTile + 3 * std::size_t(ringPairs_) : 4 * std::size_t(ringPairs_);
     work.slots.resize(ringSize * teams);
-    if (kBreak) work.over.resize(pairFirst_.size());
+    if (kBreak) work.over.resize((pairFirst_.size() + kPairTile - 1) / kPairTile);
     const LinearPairInput in = pairInput(s, kUpdateBonds, kBreak);
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
@@ -565,18 +565,22 @@ int PeridynamicBonds::proposeBreaks(const std::vector<std::uint8_t>& over,
                                     std::uint8_t* proposed) const {
     const std::uint8_t* alive = damage_->bondAlive().data();
     int breaking = 0;
-    const int end = pairsBefore(slab_.end);
-    for (int u = pairsBefore(tileStart(slab_.begin)); u < end; ++u) {
-        std::uint64_t eight = 0;  // eight pairs at once where none is past its limit
-        if (u + 8 <= end && (std::memcpy(&eight, &over[u], 8), eight == 0)) {
-            u += 7;
+    const int end = pairsBefore(slab_.end), endRow = (end + kPairTile - 1) / kPairTile;
+    for (int row = pairsBefore(tileStart(slab_.begin)) / kPairTile; row < endRow; ++row) {
+        std::uint64_t eight = 0;  // 64 pairs at once where none is past its limit
+        if (row + 8 <= endRow && (std::memcpy(&eight, &over[row], 8), eight == 0)) {
+            row += 7;
             continue;
         }
-        const bool own = pairFirst_[u] >= slab_.begin && pairFirst_[u] < slab_.end;
-        if (over[u] && !pairPad_[u] && own && alive[pairTwin_[u]]) {
-            proposed[pairTwin_[u]] = 1;
-            proposed[pairUpper_[u]] = 1;
-            breaking += 2;
+        for (unsigned bits = over[row]; bits != 0; bits &= bits - 1) {
+            const int u = kPairTile * row + std::countr_zero(bits);
+            if (u >= end) break;
+            const bool own = pairFirst_[u] >= slab_.begin && pairFirst_[u] < slab_.end;
+            if (!pairPad_[u] && own && alive[pairTwin_[u]]) {
+                proposed[pairTwin_[u]] = 1;
+                proposed[pairUpper_[u]] = 1;
+                breaking += 2;
+            }
         }
     }
     return breaking;

@@ -115,8 +115,8 @@ private:
     /// as three arrays, and whether it is past its limit).
     struct PairWorkspace : Workspace {
         std::vector<Eigen::Vector3d> pairForce;
-        std::vector<double> slots;  ///< the vectorised laws': a ring of slots per thread
-        std::vector<std::uint8_t> over;
+        std::vector<double> slots;       ///< the vectorised laws': a ring of slots per thread
+        std::vector<std::uint8_t> over;  ///< a bit per pair (LinearPairOutput::over)
     };
     /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
     LinearPairInput pairInput(const StepState& s, bool update, bool breakable) const;

@@ -51,10 +51,60 @@ bool groupOf(const int* offsets, const int* pairOf, int t, int first, int end, i
     return true;
 }
 
+/// Tile t as one union group (PairSumTiles::kUnion): its rows appended to `rows`, or false
+/// where it cannot be (a lane's bonds not in increasing offset, more than 64 life flags, a row
+/// in more than three runs). `at(u, l)`: where lane 0's x would lie for lane l's pair u.
+template <class At>
+bool unionOf(const int* offsets, const int* upperBegin, const int* pairOf, const int* partners,
+             int t, At at, std::vector<PairSumTiles::UnionRow>& rows) {
+    const int base = offsets[kTile * t];
+    if (offsets[kTile * (t + 1)] - base > 64) return false;
+    std::vector<int> all;
+    for (int l = 0; l < kTile; ++l) {
+        const int i = kTile * t + l;
+        for (int b = offsets[i]; b < offsets[i + 1]; ++b) {
+            const int d = partners[b] - i;
+            if ((b > offsets[i] && d <= partners[b - 1] - i) || (d < 0) != (b < upperBegin[i]))
+                return false;
+            all.push_back(d);
+        }
+    }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    if (all.size() > 254) return false;
+    std::vector<PairSumTiles::UnionRow> made;
+    for (const int d : all) {
+        PairSumTiles::UnionRow r{{0, 0, 0}, {0, 0, 0}, 0, d < 0, 0};
+        int runs = 0;
+        for (int l = 0; l < kTile; ++l) {
+            const int i = kTile * t + l;
+            const int* end = partners + offsets[i + 1];
+            const int* found = std::find(partners + offsets[i], end, i + d);
+            if (found == end) continue;
+            const int b = int(found - partners), u = pairOf[b];
+            if (u < 0) return false;
+            r.having |= std::uint8_t(1u << l), r.select |= std::uint64_t(1) << (b - base);
+            // A run stays inside a group of eight slots (so never wraps around a ring): lanes
+            // whose lane-0 positions agree are one run.
+            const int where = at(u, l);
+            int k = 0;
+            while (k < runs && r.at[k] != where) ++k;
+            if (k == runs) {
+                if (runs == 3) return false;
+                r.at[runs++] = where;
+            }
+            r.from[k] |= std::uint8_t(1u << l);
+        }
+        made.push_back(r);
+    }
+    rows.insert(rows.end(), made.begin(), made.end());
+    return true;
+}
+
 }  // namespace
 
 PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, const int* pairOf,
-                                 int n, unsigned slotMask) {
+                                 const int* partners, int n, unsigned slotMask) {
     PairSumTiles s;
     s.slotMask = slotMask, s.directedBonds = offsets[n];
     // Where lane 0's x would lie, for lane l's pair u: l before u's.
@@ -86,6 +136,16 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
                 }
             }
             s.groups.push_back(group);
+        }
+        const int made = int(s.groups.size()) - s.groupFirst[t];
+        const Group& first = s.groups[s.groupFirst[t]];
+        const bool whole = made == 1 && first.endLane == kTile && first.bonds > 0;
+        const int before = int(s.unionRows.size());
+        if (!whole && partners &&
+            unionOf(offsets, upperBegin, pairOf, partners, t, at, s.unionRows)) {
+            const int rows = int(s.unionRows.size()) - before;
+            s.groups.resize(s.groupFirst[t]);
+            s.groups.push_back(Group{0, std::uint8_t(kTile), std::uint8_t(rows), kUnion, before});
         }
         s.groupFirst[t + 1] = int(s.groups.size());
     }
@@ -258,10 +318,48 @@ template <int kBonds>
     storeParticles(out, x, y, z, stream);
 }
 
+/// A union row's x (or y, z: `at` after) of its lanes: run A's load, runs B and C blended in.
+[[REND_TILE_TARGET]] inline __m512d unionLanes(const double* pairForce,
+                                               const PairSumTiles::UnionRow& r, int at) {
+    __m512d v = _mm512_loadu_pd(pairForce + r.at[0] + at);
+    if (r.from[1] != 0)
+        v = _mm512_mask_blend_pd(r.from[1], v, _mm512_loadu_pd(pairForce + r.at[1] + at));
+    if (r.from[2] != 0)
+        v = _mm512_mask_blend_pd(r.from[2], v, _mm512_loadu_pd(pairForce + r.at[2] + at));
+    return v;
+}
+
+/// A tile of lanes with different bonds (PairSumTiles::kUnion), as one group: its rows in
+/// increasing offset, each lane's existing bonds in its own order, the others masked off.
+[[REND_TILE_TARGET]] void sumUnionTile(const PairGather& g, const PairSumTiles& s,
+                                       const PairSumTiles::Group& one, int t, bool stream) {
+    const int base = g.offsets[kTile * t], flags = g.offsets[kTile * (t + 1)] - base;
+    const __mmask64 in = flags >= 64 ? ~__mmask64(0) : (__mmask64(1) << flags) - 1;
+    const __m512i bytes = _mm512_maskz_loadu_epi8(in, g.alive + base);
+    const std::uint64_t life = _mm512_test_epi8_mask(bytes, bytes);
+    __m512d x = _mm512_setzero_pd(), y = x, z = x;
+    for (int q = one.rowFirst; q < one.rowFirst + one.bonds; ++q) {
+        const PairSumTiles::UnionRow& r = s.unionRows[q];
+        const __mmask8 on = __mmask8(_pdep_u64(_pext_u64(life, r.select), r.having));
+        const __m512d fx = unionLanes(g.pairForce, r, 0);
+        const __m512d fy = unionLanes(g.pairForce, r, kPairTile);
+        const __m512d fz = unionLanes(g.pairForce, r, 2 * kPairTile);
+        if (r.minus) {
+            x = _mm512_mask_sub_pd(x, on, x, fx), y = _mm512_mask_sub_pd(y, on, y, fy);
+            z = _mm512_mask_sub_pd(z, on, z, fz);
+        } else {
+            x = _mm512_mask_add_pd(x, on, x, fx), y = _mm512_mask_add_pd(y, on, y, fy);
+            z = _mm512_mask_add_pd(z, on, z, fz);
+        }
+    }
+    storeParticles(g.force + 3 * kTile * std::size_t(t), x, y, z, stream);
+}
+
 /// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
 /// group (a group without rows one particle at a time, after the tile's store).
 [[REND_TILE_TARGET]] void sumTile(const PairGather& g, const PairSumTiles& s, int t, bool stream) {
     if (const PairSumTiles::Group& one = s.groups[s.groupFirst[t]]; one.endLane == kTile) {
+        if (one.lower == PairSumTiles::kUnion) return sumUnionTile(g, s, one, t, stream);
         const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
         const std::uint8_t* alive = g.alive + g.offsets[kTile * t];
         double* out = g.force + 3 * kTile * std::size_t(t);

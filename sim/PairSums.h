@@ -4,9 +4,10 @@
 // is the pair's larger index (sim/Bonds.h's BondPairs). One particle at a time, or, with
 // AVX-512, eight at once: a tile (sim/PeridynamicBonds.h's order) whose particles have the same
 // number of bonds, the same number of lower copies and, bond by bond, their pairs in at most two
-// runs of consecutive slots, as almost every tile of a regular lattice has. Each lane adds the
-// same terms in the same order as one particle's loop, skipping the dead bonds by a mask: the
-// same bits.
+// runs of consecutive slots, as almost every tile of a regular lattice has; or a tile whose
+// particles' bonds differ (where a lattice's row ends) as one group over their partner offsets,
+// in at most three runs. Each lane adds the same terms in the same order as one particle's
+// loop, skipping the dead bonds (and the bonds it does not have) by a mask: the same bits.
 
 #include <cstdint>
 #include <vector>
@@ -16,7 +17,7 @@ namespace rend::sim {
 /// The tiles of kTile particles whose sums run eight lanes wide, each in groups of
 /// consecutive lanes with the same number of bonds and of lower copies among them, whose k-th
 /// bonds' pairs lie in at most two runs of consecutive slots (a tile inside a regular lattice's
-/// row is one group; one where a row ends, three or four).
+/// row is one group), or one union group (below) where a lattice's row ends.
 struct PairSumTiles {
     static constexpr int kTile = 8;
     static constexpr int kMostBonds = 16;  ///< a group's life flags in two 64-byte loads
@@ -34,13 +35,26 @@ struct PairSumTiles {
         std::uint8_t fromA;
     };
     std::vector<Row> rows;
+    /// A tile whose lanes differ in their bonds (where a lattice's row ends: its last particle
+    /// and the next row's first have fewer), summed as one group: a row per partner offset j - i
+    /// of any lane, in increasing order (each lane's bond order), the lanes without a bond of
+    /// that offset masked off. Its group has lower == kUnion and rowFirst into unionRows.
+    static constexpr std::uint8_t kUnion = 255;
+    struct UnionRow {
+        int at[3];             ///< where lane 0's x would lie in each run's slots
+        std::uint8_t from[3];  ///< the lanes of each run (from[1], from[2] may be 0)
+        std::uint8_t having;   ///< the lanes with a bond of this offset
+        bool minus;            ///< a lower copy's offset: taken away
+        std::uint64_t select;  ///< those bonds' life flags among the tile's (one bit per lane)
+    };
+    std::vector<UnionRow> unionRows;
     unsigned slotMask = ~0u;
     int directedBonds = 0;  ///< offsets[n]
 
-    /// The tiles of particles [0, n) from the CSR offsets, upper copies' starts and each
-    /// directed bond's pair, for a ring of slotMask + 1 slots (a power of 2, at least kTile).
-    static PairSumTiles build(const int* offsets, const int* upperBegin, const int* pairOf, int n,
-                              unsigned slotMask);
+    /// The tiles of particles [0, n) from the CSR offsets, upper copies' starts, each directed
+    /// bond's pair and partner, for a ring of slotMask + 1 slots (a power of 2, at least kTile).
+    static PairSumTiles build(const int* offsets, const int* upperBegin, const int* pairOf,
+                              const int* partners, int n, unsigned slotMask);
 };
 
 struct PairGather {

@@ -112,7 +112,7 @@ void PeridynamicBonds::setUpPairArrays() {
     ringPairs_ = 1;
     while (ringPairs_ < window) ringPairs_ *= 2;
     sumTiles_ = PairSumTiles::build(bonds_.offsets.data(), pairs_.upperBegin.data(), slotOf_.data(),
-                                    n, unsigned(ringPairs_ - 1));
+                                    bonds_.partners.data(), n, unsigned(ringPairs_ - 1));
 }
 
 // Per row of a tile (its particles' k-th pairs, side by side): whether its ends are two runs of

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <vector>
 
@@ -56,7 +57,8 @@ struct Sums {
           pairOf(std::move(pairs)),
           alive(bonds.directedCount(), 1),
           tiles(PairSumTiles::build(bonds.offsets.data(), this->pairs.upperBegin.data(),
-                                    pairOf.data(), bonds.particleCount(), slotMask)),
+                                    pairOf.data(), bonds.partners.data(), bonds.particleCount(),
+                                    slotMask)),
           slotMask(slotMask) {
         const int most = *std::max_element(pairOf.begin(), pairOf.end());
         const unsigned used = std::min(unsigned(most), slotMask) + 1;
@@ -136,14 +138,27 @@ INSTANTIATE_TEST_SUITE_P(Lattices, PairSums,
                                            Case{LatticeKind::Square, 2.2},
                                            Case{LatticeKind::Hexagonal, 2.5}));
 
+/// A square sheet of 24 + 1 particles per row and its sums' tiles: many tiles lie inside a
+/// row, the others cross its end.
+struct RowsOf25 {
+    RowsOf25()
+        : bonds(sheetBonds(0.24, 0.1, LatticeKind::Square, 1.5)),
+          pairs(buildBondPairs(bonds)),
+          pairOf(tilePairs(bonds, pairs)),
+          tiles(PairSumTiles::build(bonds.offsets.data(), pairs.upperBegin.data(), pairOf.data(),
+                                    bonds.partners.data(), bonds.particleCount(), 63u)) {}
+    static constexpr int rowLength = 25;
+    BondFamilies bonds;
+    BondPairs pairs;
+    std::vector<int> pairOf;
+    PairSumTiles tiles;
+};
+
 TEST(PairSumTiles, TileInsideALatticeRowIsOneGroupOfEightLanes) {
-    // 24 + 1 particles per row: many tiles lie inside a row, the others cross its end.
-    const BondFamilies bonds = sheetBonds(0.24, 0.1, LatticeKind::Square, 1.5);
-    const BondPairs pairs = buildBondPairs(bonds);
-    const std::vector<int> pairOf = tilePairs(bonds, pairs);
-    const PairSumTiles tiles = PairSumTiles::build(bonds.offsets.data(), pairs.upperBegin.data(),
-                                                   pairOf.data(), bonds.particleCount(), 63u);
-    const int rowLength = 25, tileCount = bonds.particleCount() / kTile;
+    const RowsOf25 sheet;
+    const BondFamilies& bonds = sheet.bonds;
+    const PairSumTiles& tiles = sheet.tiles;
+    const int rowLength = RowsOf25::rowLength, tileCount = bonds.particleCount() / kTile;
     int whole = 0, inside = 0;
     for (int t = 0; t < tileCount; ++t) {
         const int first = kTile * t, last = first + kTile - 1;
@@ -168,6 +183,36 @@ TEST(PairSumTiles, TileInsideALatticeRowIsOneGroupOfEightLanes) {
         }
         EXPECT_EQ(lane, kTile);
     }
+}
+
+// A tile that holds a row's last particle and the next row's first (5 bonds each, against 8)
+// is summed as one group: a row per partner offset, the lanes without it masked off (its
+// bits are PairSums.HaveTheBitsOfOneParticleAtATime's).
+TEST(PairSumTiles, TileAcrossARowsEndIsOneUnionGroup) {
+    const RowsOf25 sheet;
+    const BondFamilies& bonds = sheet.bonds;
+    const PairSumTiles& tiles = sheet.tiles;
+    const int rowLength = RowsOf25::rowLength, tileCount = bonds.particleCount() / kTile;
+    int across = 0, unions = 0;
+    for (int t = 0; t < tileCount; ++t) {
+        const int first = kTile * t, last = first + kTile - 1;
+        // Across a row's end, between the sheet's second and second-to-last rows.
+        if (first / rowLength == last / rowLength || first < 2 * rowLength ||
+            last >= bonds.particleCount() - 2 * rowLength)
+            continue;
+        ++across;
+        const PairSumTiles::Group& g = tiles.groups[tiles.groupFirst[t]];
+        if (tiles.groupFirst[t + 1] - tiles.groupFirst[t] != 1 || g.lower != PairSumTiles::kUnion)
+            continue;
+        ++unions;
+        EXPECT_EQ(g.bonds, 8) << "tile " << t << ": the eight offsets of the square lattice";
+        int having = 0;
+        for (int q = g.rowFirst; q < g.rowFirst + g.bonds; ++q)
+            having += std::popcount(unsigned(tiles.unionRows[q].having));
+        EXPECT_EQ(having, bonds.offsets[last + 1] - bonds.offsets[first]) << "tile " << t;
+    }
+    EXPECT_GT(across, 3);
+    EXPECT_EQ(unions, across);
 }
 
 }  // namespace

@@ -9,6 +9,28 @@
 
 namespace rend::sim {
 
+namespace {
+
+/// The partner offsets j - i of tile t's particles' bonds, each once, in increasing order; none
+/// where a particle's bonds are not in increasing offset.
+std::vector<int> unionOffsets(const BondFamilies& bonds, int t) {
+    constexpr int kTile = DiffusionTiles::kTile;
+    std::vector<int> all;
+    for (int i = kTile * t; i < std::min(bonds.particleCount(), kTile * (t + 1)); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            if (b > bonds.offsets[i] && bonds.partners[b] <= bonds.partners[b - 1]) return {};
+            all.push_back(bonds.partners[b] - i);
+        }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    return all;
+}
+
+}  // namespace
+
+// Each tile's rows: the k-th bonds of its particles side by side; or, where its particles' bonds
+// differ (a lattice row's end) but span no more offsets than its most bonds, a row per offset,
+// the particles without it padded (masked off, their partner in the row's run).
 DiffusionTiles DiffusionTiles::build(const BondFamilies& bonds, const std::vector<double>& rate) {
     const int n = bonds.particleCount(), tiles = (n + kTile - 1) / kTile;
     const auto count = [&](int i) { return i < n ? bonds.offsets[i + 1] - bonds.offsets[i] : 0; };
@@ -22,16 +44,27 @@ DiffusionTiles DiffusionTiles::build(const BondFamilies& bonds, const std::vecto
     const int slots = d.tileBegin[tiles];
     d.partner.assign(slots, 0), d.bond.assign(slots, -1), d.rate.assign(slots, 0.0);
     d.living.assign(slots, 0);
-    for (int t = 0; t < tiles; ++t)
+    for (int t = 0; t < tiles; ++t) {
+        const std::vector<int> offsets = unionOffsets(bonds, t);
+        const int rows = (d.tileBegin[t + 1] - d.tileBegin[t]) / kTile;
+        const bool byOffset = int(offsets.size()) == rows;
         for (int lane = 0; lane < kTile; ++lane) {
             const int i = kTile * t + lane;
-            for (int k = 0, u = d.tileBegin[t] + lane; u < d.tileBegin[t + 1]; ++k, u += kTile) {
+            int k = 0;  // the lane's next bond
+            for (int q = 0, u = d.tileBegin[t] + lane; q < rows; ++q, u += kTile) {
                 d.partner[u] = std::min(i, n - 1);
-                if (k >= count(i)) continue;
-                const int b = bonds.offsets[i] + k;
+                if (byOffset) {  // the row of one offset: its partner, or a pad in the run
+                    const int j = i + offsets[q];
+                    if (j >= 0 && j < n) d.partner[u] = j;
+                    if (k >= count(i) || bonds.partners[bonds.offsets[i] + k] != j) continue;
+                } else if (k >= count(i)) {
+                    continue;
+                }
+                const int b = bonds.offsets[i] + k++;
                 d.partner[u] = bonds.partners[b], d.bond[u] = b, d.rate[u] = rate[b];
             }
         }
+    }
     return d;
 }
 

@@ -16,17 +16,20 @@ using namespace rend::sim;
 
 namespace {
 
-/// A hexagonal sheet whose particle count is not a multiple of 8, bonds within 2.5 dx: the
-/// edges' particles have fewer bonds than the interior's, so tiles there carry pads.
+/// A sheet whose particle count is not a multiple of 8, hexagonal with bonds within 2.5 dx, or
+/// square within 1.5 dx (31 particles a row: a tile in four holds a row's end, as rows of one
+/// offset): the edges' particles have fewer bonds than the interior's, so tiles there carry pads.
 struct Sheet {
-    Sheet() {
-        params.sheet.size = {0.31, 0.17};
+    explicit Sheet(LatticeKind kind = LatticeKind::Hexagonal) {
+        const bool square = kind == LatticeKind::Square;
+        params.sheet.size = {square ? 0.30 : 0.31, 0.17};
         params.sheet.dx = 0.01;
-        params.sheet.horizonFactor = 2.5;
+        params.sheet.lattice = kind;
+        params.sheet.horizonFactor = square ? 1.5 : 2.5;
         params.material.density = 5000.0, params.material.capacity = 1.0;
         params.material.conductivity = 50.0;
         lattice = generateLattice(params.sheet);
-        bonds = buildBondFamilies(lattice.positions, 2.5 * params.sheet.dx);
+        bonds = buildBondFamilies(lattice.positions, params.sheet.horizonFactor * params.sheet.dx);
         volumes.assign(lattice.positions.size(), lattice.particleArea * params.sheet.thickness);
     }
     MembraneParams params;
@@ -48,8 +51,10 @@ std::vector<double> naiveStep(const BondFamilies& bonds, const std::vector<doubl
     return next;
 }
 
-TEST(DiffusionTiles, SumEachParticlesLivingBondsInOrder) {
-    const Sheet sheet;
+class DiffusionTileSums : public ::testing::TestWithParam<LatticeKind> {};
+
+TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
+    const Sheet sheet(GetParam());
     const BondFamilies& bonds = sheet.bonds;
     const int n = bonds.particleCount();
     ASSERT_NE(n % DiffusionTiles::kTile, 0);
@@ -71,7 +76,25 @@ TEST(DiffusionTiles, SumEachParticlesLivingBondsInOrder) {
     int differ = 0;
     for (int i = 0; i < n; ++i) differ += next[i] != expected[i];
     EXPECT_EQ(differ, 0) << "of " << n;
+    // On the square sheet, away from its first and last two rows, every row of a tile is a run
+    // of consecutive partners, the tiles across a lattice row's end too (a row per offset): no
+    // row gathers its theta.
+    if (GetParam() != LatticeKind::Square) return;
+    constexpr int kTile = DiffusionTiles::kTile, kRow = 31;
+    int rows = 0, runs = 0;
+    for (int t = 2 * kRow / kTile + 1; kTile * (t + 1) + 2 * kRow < n; ++t)
+        for (int u = tiles.tileBegin[t]; u < tiles.tileBegin[t + 1]; u += kTile) {
+            bool run = true;
+            for (int l = 0; l < kTile; ++l)
+                run = run && tiles.partner[u + l] == tiles.partner[u] + l;
+            ++rows, runs += run;
+        }
+    EXPECT_GT(rows, 300);
+    EXPECT_EQ(runs, rows);
 }
+
+INSTANTIATE_TEST_SUITE_P(Lattices, DiffusionTileSums,
+                         ::testing::Values(LatticeKind::Hexagonal, LatticeKind::Square));
 
 // A diffusion that stepped before some bonds broke steps afterwards as one built on the broken
 // bonds does: its copy of which bonds live follows DamageState::version().

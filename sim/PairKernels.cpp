@@ -350,7 +350,7 @@ struct Simd {
 
 template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
-    double stiffest = 1.0;
+    double stiffest = in.stiffestKnown;
 #if defined(__x86_64__)
     if (simdWidth() == 8)
         begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);

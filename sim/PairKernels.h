@@ -35,6 +35,9 @@ struct LinearPairInput {
     double powerC = 0.0, powerCStar = 0.0, powerN = 4.0;
     /// advance(): the power law's look-ahead (needs v, dt), the elastoplastic history's update.
     bool update = false;
+    /// The largest look-ahead tangent over c the caller already found (at least 1): lanes that
+    /// cannot exceed it are not looked at, and the answer is at least it.
+    double stiffestKnown = 1.0;
     const double* v = nullptr;
     double dt = 0.0;
     const std::uint8_t* alive = nullptr;  ///< per directed bond

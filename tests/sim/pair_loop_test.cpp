@@ -173,41 +173,64 @@ struct SmallSheet {
     DamageState damage;
 };
 
-TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
-    SmallSheet sheet(SmallSheet::params(BondLawKind::PowerLaw));
-    auto& [p, lattice, bonds, volumes, solver, damage] = sheet;
-    const int n = int(lattice.positions.size());
-    std::vector<Eigen::Vector3d> x = lattice.positions, v(n);
-    for (int i = 0; i < n; ++i)
-        for (int a = 0; a < 3; ++a) {
-            x[i][a] += 0.2 * p.sheet.dx * (2.0 * uniformFromHash(3, 3 * i + a) - 1.0);
-            v[i][a] = 2.0 * uniformFromHash(4, 3 * i + a) - 1.0;
+/// The largest look-ahead tangent over the living compressed bonds of `bonds` at x, v and dt,
+/// as the loop over bonds computes it; its bond in `stiffestBond`.
+double lookAheadOverBonds(const PeridynamicBonds& solver, const BondFamilies& bonds,
+                          const DamageState& damage, const std::vector<Eigen::Vector3d>& x,
+                          const std::vector<Eigen::Vector3d>& v, double dt, int& stiffestBond) {
+    double expected = 1.0;
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
+            if (!damage.bondAlive()[b]) continue;
+            const int j = bonds.partners[b];
+            const Eigen::Vector3d r = x[j] - x[i];
+            const double eta = r.norm() / bonds.restLength[b] - 1.0;
+            if (!(eta < 0.0)) continue;
+            const double rate = r.dot(v[j] - v[i]) / (r.norm() * bonds.restLength[b]);
+            const double t =
+                solver.law().powerLawStiffening(clampCompression(eta + std::min(0.0, dt * rate)));
+            if (t > expected) expected = t, stiffestBond = b;
         }
-    const double dt = 1e-3;
-    // The stiffest bond, broken: the look-ahead must pass over it.
-    double expected = 1.0, stiffest = 1.0;
-    int stiffestBond = -1;
-    for (int pass = 0; pass < 2; ++pass) {
-        expected = 1.0, stiffest = 1.0;
-        for (int i = 0; i < n; ++i)
-            for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b) {
-                if (!damage.bondAlive()[b]) continue;
-                const int j = bonds.partners[b];
-                const Eigen::Vector3d r = x[j] - x[i];
-                const double eta = r.norm() / bonds.restLength[b] - 1.0;
-                if (!(eta < 0.0)) continue;
-                const double rate = r.dot(v[j] - v[i]) / (r.norm() * bonds.restLength[b]);
-                const double t = solver.law().powerLawStiffening(
-                    clampCompression(eta + std::min(0.0, dt * rate)));
-                if (t > expected) expected = t, stiffestBond = b;
+    return expected;
+}
+
+// On the small sheet (one block) and on one of 1 x 0.5 m (blocks of 512 particles, each
+// starting from the largest tangent of the blocks before it, on 1 and 3 threads). Particles
+// moved by `jitter` dx: much, so that one bond stands out, or little, so that many compete.
+TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
+    const int before = omp_get_max_threads();
+    for (const bool large : {false, true})
+        for (const double jitter : {0.2, 0.002}) {
+            MembraneParams params = SmallSheet::params(BondLawKind::PowerLaw);
+            if (large) params.sheet.size = {1.0, 0.5};
+            SmallSheet sheet(params);
+            auto& [p, lattice, bonds, volumes, solver, damage] = sheet;
+            const int n = int(lattice.positions.size());
+            std::vector<Eigen::Vector3d> x = lattice.positions, v(n);
+            for (int i = 0; i < n; ++i)
+                for (int a = 0; a < 3; ++a) {
+                    x[i][a] += jitter * p.sheet.dx * (2.0 * uniformFromHash(3, 3 * i + a) - 1.0);
+                    v[i][a] = 2.0 * uniformFromHash(4, 3 * i + a) - 1.0;
+                }
+            const double dt = 1e-3;
+            // The stiffest bond, broken: the look-ahead must pass over it.
+            for (int pass = 0; pass < 2; ++pass) {
+                int stiffestBond = -1;
+                const double expected =
+                    lookAheadOverBonds(solver, bonds, damage, x, v, dt, stiffestBond);
+                EXPECT_GT(expected, 1.0);
+                for (const int threads : {1, 3}) {
+                    omp_set_num_threads(threads);
+                    solver.advanceAt(x, v, dt);
+                    EXPECT_EQ(solver.stiffening(), expected)
+                        << (large ? "large" : "small") << ", jitter " << jitter << ", pass " << pass
+                        << ", " << threads << " threads";
+                }
+                ASSERT_GT(stiffestBond, 0);
+                damage.breakBond(stiffestBond);
             }
-        solver.advanceAt(x, v, dt);
-        stiffest = solver.stiffening();
-        EXPECT_GT(expected, 1.0);
-        EXPECT_EQ(stiffest, expected) << "pass " << pass;
-        ASSERT_GT(stiffestBond, 0);
-        damage.breakBond(stiffestBond);
-    }
+        }
+    omp_set_num_threads(before);
 }
 
 // advance() moves the elastoplastic history on in the kernel: both copies of every living,

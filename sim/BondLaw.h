@@ -102,7 +102,7 @@ struct BondLaw {
     /// Eq. 20's force on the loading path at strain eta >= eta0 (lawExp: the vector kernels'
     /// bits).
     double yieldForce(double eta) const {
-        return c * yieldStrain * lawExp(-softening * (eta - yieldStrain) / yieldStrain);
+        return c * yieldStrain * lawExp((yieldStrain - eta) * (softening / yieldStrain));
     }
 
     /// Permanent strain left after loading to maxStrain (0 while it stayed elastic).

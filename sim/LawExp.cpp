@@ -5,15 +5,24 @@
 
 namespace rend::sim {
 
+namespace {
+
+struct ScalarOps {
+    static double set1(double a) { return a; }
+    static double sub(double a, double b) { return a - b; }
+    static double mul(double a, double b) { return a * b; }
+    static double fma(double a, double b, double c) { return std::fma(a, b, c); }
+};
+
+}  // namespace
+
 double lawExp(double x) {
     using namespace lawexp;
     if (std::isnan(x)) return x;
     x = std::min(std::max(x, kLowest), kHighest);
-    const double t = x * kLog2e + kShift;
-    const double n = t - kShift;
-    const double r = (x - n * kLn2Hi) - n * kLn2Lo;
-    double p = kInverseFactorial.c[kTerms];
-    for (int k = kTerms - 1; k >= 0; --k) p = p * r + kInverseFactorial.c[k];
+    double t, r;
+    reduce<ScalarOps>(x, t, r);
+    const double p = estrin<ScalarOps>(r);
     // 2^n as 2^n1 2^n2, n1 = floor(n / 2): each a normal number, so that only the last product
     // rounds (to a subnormal, 0 or infinity where e^x is one).
     const std::int64_t whole = std::bit_cast<std::int64_t>(t) - kShiftBits;

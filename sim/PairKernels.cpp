@@ -145,10 +145,10 @@ inline double lookAheadReach(const LinearPairInput& in, double stiffest, bool th
 // Each width's code is compiled for its instruction set: GCC by `#pragma GCC target`, clang (the
 // fuzz build) by `#pragma clang attribute`.
 #if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
 #else
 #pragma GCC push_options
-#pragma GCC target("avx2")
+#pragma GCC target("avx2,fma")
 #endif
 namespace avx2 {
 
@@ -165,6 +165,7 @@ struct Simd {
     static V add(V a, V b) { return _mm256_add_pd(a, b); }
     static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
     static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
+    static V fma(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }  ///< a b + c, one rounding
     static V div(V a, V b) { return _mm256_div_pd(a, b); }
     static V sqrt(V a) { return _mm256_sqrt_pd(a); }
     static V max(V a, V b) { return _mm256_max_pd(a, b); }
@@ -251,11 +252,11 @@ struct Simd {
 }  // namespace avx2
 #if defined(__clang__)
 #pragma clang attribute pop
-#pragma clang attribute push(__attribute__((target("avx2,avx512f"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx2,fma,avx512f"))), apply_to = function)
 #else
 #pragma GCC pop_options
 #pragma GCC push_options
-#pragma GCC target("avx2,avx512f")
+#pragma GCC target("avx2,fma,avx512f")
 #endif
 namespace avx512 {
 
@@ -273,6 +274,7 @@ struct Simd {
     static V add(V a, V b) { return _mm512_add_pd(a, b); }
     static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
     static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+    static V fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
     static V div(V a, V b) { return _mm512_div_pd(a, b); }
     static V sqrt(V a) { return _mm512_sqrt_pd(a); }
     static V max(V a, V b) { return _mm512_max_pd(a, b); }

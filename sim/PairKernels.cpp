@@ -354,7 +354,14 @@ template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = in.stiffestKnown;
 #if defined(__x86_64__)
-    if (simdWidth() == 8)
+    constexpr bool kLookAhead = kLaw == BondLawKind::PowerLaw && kUpdate;
+    if (kLookAhead && in.skipFar && simdWidth() == 8)
+        begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead>(in, out, begin, end,
+                                                                                stiffest);
+    else if (kLookAhead && in.skipFar && simdWidth() == 4)
+        begin = avx2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead>(in, out, begin, end,
+                                                                              stiffest);
+    else if (simdWidth() == 8)
         begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
     else if (simdWidth() == 4)
         begin = avx2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
@@ -387,6 +394,23 @@ double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int be
 #endif
     for (int u = begin; u < end; ++u) fastest = std::max(fastest, approachOf(in, a, u));
     return fastest;
+}
+
+double largestMagnitude(const double* p, std::size_t n) {
+#if defined(__x86_64__)
+    if (simdWidth() == 8) return avx512::largestMagnitude(p, n);
+    if (simdWidth() == 4) return avx2::largestMagnitude(p, n);
+#endif
+    double largest = 0.0;
+    for (std::size_t k = 0; k < n; ++k) largest = std::max(largest, std::fabs(p[k]));
+    return largest;
+}
+
+double lookAheadSlack(double largest, double dt) {
+    // 1e-100: a sheet at rest still gets a positive slack, far from any underflow of the tests.
+    const double slack = dt * (2.0 * std::sqrt(3.0) * (1.0 + 0x1p-20)) * std::max(largest, 1e-100);
+    return slack <= std::numeric_limits<double>::max() ? slack
+                                                       : std::numeric_limits<double>::infinity();
 }
 
 void lawExpLanes(const double* x, double* y, int n) {

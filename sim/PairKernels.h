@@ -4,11 +4,13 @@
 // history): each pair's force on its smaller index, from structure-of-arrays inputs, for a range
 // of pairs. sim/PairSums.h sums the pair forces per particle. Eight pairs at a time
 // with AVX-512 where the CPU has it, else four with AVX2, else one at a time
-// (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt (no
-// fused multiply-add), so their bits are the same. The width is sim/StepKernels.h's simdWidth().
+// (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt, and
+// fused multiply-adds only in eq. 20's e^x (sim/LawExp.h, at every width), so their bits are the
+// same. The width is sim/StepKernels.h's simdWidth().
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "sim/BondLaw.h"
 
@@ -40,6 +42,12 @@ struct LinearPairInput {
     double stiffestKnown = 1.0;
     const double* v = nullptr;
     double dt = 0.0;
+    /// lookAheadSlack() of the particles the pairs reach: a lane with (eta - reach) rest at or
+    /// above it cannot stretch back below the look-ahead's reach within dt. With skipFar, a
+    /// vector with no compressed lane nearer than that skips the look-ahead (its velocities are
+    /// not read), and LinearPairOutput::nearRows counts the others.
+    double lookAheadSlack = std::numeric_limits<double>::infinity();
+    bool skipFar = false;
     const std::uint8_t* alive = nullptr;  ///< per directed bond
     bool allAlive = false;                ///< no bond has broken: every alive flag is 1
     const int* upper = nullptr;           ///< per pair: its upper copy
@@ -86,6 +94,9 @@ struct LinearPairOutput {
     std::uint8_t* over = nullptr;
     int slotBase = 0;
     bool rows = false;  ///< slotRows()
+    /// With LinearPairInput::skipFar: the vectors with a compressed lane within its
+    /// lookAheadSlack of the reach are added to it.
+    int* nearRows = nullptr;
 };
 
 /// Membrane::failureApproachRate's measure: how fast the pairs loaded past half their critical
@@ -102,6 +113,14 @@ struct ApproachRate {
 /// pads and whose first end is owned; 0 if none. The bits of Membrane's loop over bonds, term by
 /// term (in.x, in.v, in.theta, in.restLength or its classes).
 double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int begin, int end);
+
+/// The largest |p[k]| of n values, simdWidth() lanes at a time (a NaN may be left out).
+double largestMagnitude(const double* p, std::size_t n);
+
+/// dt |v_j - v_i| bounded from the largest |component| of the particles' velocities, above its
+/// rounding: dt 2 sqrt(3) (1 + 2^-20) largest (a NaN component left out, as the look-ahead's
+/// tests leave a NaN rate out); infinity where that is not finite.
+double lookAheadSlack(double largest, double dt);
 
 /// y[k] = e^x[k] as the elastoplastic kernel computes it, simdWidth() lanes at a time (the bits
 /// of sim/LawExp.h's lawExp).

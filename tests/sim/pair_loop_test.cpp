@@ -6,12 +6,15 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <vector>
 
 #include "sim/Domain.h"
 #include "sim/Material.h"
+#include "sim/PairKernels.h"
 #include "sim/PeridynamicBonds.h"
 #include "sim/Random.h"
 
@@ -231,6 +234,32 @@ TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
             }
         }
     omp_set_num_threads(before);
+}
+
+// The look-ahead's slack (LinearPairInput::lookAheadSlack): at least dt |v_j - v_i| for any two
+// of the particles it was taken over, the largest |component| at every width and length (the
+// lanes and the rest), infinity for an infinite velocity, and positive for a sheet at rest.
+TEST(PairLoop, TheLookAheadSlackBoundsEveryPairsRelativeVelocity) {
+    for (const int n : {1, 7, 8, 9, 100, 333}) {
+        std::vector<double> v(3 * n);
+        double largest = 0.0;
+        for (int k = 0; k < 3 * n; ++k) {
+            v[k] = 4.0 * uniformFromHash(31, k) - 2.0;
+            largest = std::max(largest, std::abs(v[k]));
+        }
+        ASSERT_EQ(largestMagnitude(v.data(), v.size()), largest) << n;
+        const double dt = 1e-3, slack = lookAheadSlack(largestMagnitude(v.data(), v.size()), dt);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const double dx = v[3 * j] - v[3 * i], dy = v[3 * j + 1] - v[3 * i + 1],
+                             dz = v[3 * j + 2] - v[3 * i + 2];
+                EXPECT_LT(dt * std::sqrt(dx * dx + dy * dy + dz * dz), slack) << n;
+            }
+        v[3 * n / 2] = std::numeric_limits<double>::infinity();
+        EXPECT_EQ(lookAheadSlack(largestMagnitude(v.data(), v.size()), dt),
+                  std::numeric_limits<double>::infinity());
+    }
+    EXPECT_GT(lookAheadSlack(0.0, 1e-4), 0.0);
 }
 
 // advance() moves the elastoplastic history on in the kernel: both copies of every living,

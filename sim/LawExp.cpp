@@ -14,6 +14,8 @@ struct ScalarOps {
     static double fma(double a, double b, double c) { return std::fma(a, b, c); }
 };
 
+#include "sim/LawExpSteps.inc"
+
 }  // namespace
 
 double lawExp(double x) {

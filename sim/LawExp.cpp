@@ -9,6 +9,7 @@ namespace {
 
 struct ScalarOps {
     static double set1(double a) { return a; }
+    static double add(double a, double b) { return a + b; }
     static double sub(double a, double b) { return a - b; }
     static double mul(double a, double b) { return a * b; }
     static double fma(double a, double b, double c) { return std::fma(a, b, c); }

@@ -61,7 +61,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             row = std::uint8_t((bit == 0 ? 0u : row & ~(1u << bit)) | unsigned(past) << bit);
         }
         if constexpr (kLaw == BondLawKind::PowerLaw) {  // eq. 19, and the tangent in dt
-            if (kUpdate && eta < 0.0 && !past && in.alive[in.upper[u]]) {
+            if (kUpdate && eta < 0.0 && !past && i >= in.ownBegin && in.alive[in.upper[u]]) {
                 const double* v = in.v;
                 const double rate =
                     (rx * (v[3 * j] - v[3 * i]) + ry * (v[3 * j + 1] - v[3 * i + 1]) +

@@ -42,6 +42,10 @@ struct LinearPairInput {
     double stiffestKnown = 1.0;
     const double* v = nullptr;
     double dt = 0.0;
+    /// The look-ahead counts only the pairs whose first end is at or past it: this process's
+    /// own (a decomposed run computes its ghosts' pairs for its sums, but whether a bond between
+    /// two ghosts lives is their owner's to know).
+    int ownBegin = 0;
     /// lookAheadSlack() of the particles the pairs reach: a lane with (eta - reach) rest at or
     /// above it cannot stretch back below the look-ahead's reach within dt. With skipFar, a
     /// vector with no compressed lane nearer than that skips the look-ahead (its velocities are

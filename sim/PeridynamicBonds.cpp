@@ -405,7 +405,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
             if constexpr (kUpdateBonds) plastic[b] = plastic[twin[u]] = state;
         }
         if constexpr (kUpdateBonds && kLaw == BondLawKind::PowerLaw) {
-            if (eta < 0.0) {  // its tangent where it will be in dt, if it closes
+            if (eta < 0.0 && i >= slab_.begin) {  // its tangent in dt, if it closes (own i)
                 const double rate = r.dot(v[j] - v[i]) / (length * restLength[b]);
                 const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
                 double tangent =
@@ -467,6 +467,7 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.update = update;
     in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();
+    in.ownBegin = slab_.begin;
     in.allAlive = damage_->brokenBondCount() == 0;
     in.twin = pairTwin_.data();
     if (!plastic_.empty()) {
@@ -619,14 +620,16 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     updates.stiffest = stiffest;
 }
 
-// The pairs past their limit among this process's own particles' upper copies (not the pads):
-// both copies proposed.
+// The pairs past their limit among the upper copies this process computes (not the pads): both
+// copies proposed. A decomposed run computes the pairs of its ghosts below its own particles
+// too, with the owner's bits, and breaks them as the owner does: a bond between a ghost and an
+// own particle breaks on both processes in the same step (the scalar loop's rule too).
 int PeridynamicBonds::proposeBreaks(const std::vector<std::uint8_t>& over,
                                     std::uint8_t* proposed) const {
     const std::uint8_t* alive = damage_->bondAlive().data();
     int breaking = 0;
     const int end = pairsBefore(slab_.end), endRow = (end + kPairTile - 1) / kPairTile;
-    for (int row = pairsBefore(tileStart(slab_.begin)) / kPairTile; row < endRow; ++row) {
+    for (int row = pairsBefore(tileStart(slab_.ghostBegin)) / kPairTile; row < endRow; ++row) {
         std::uint64_t eight = 0;  // 64 pairs at once where none is past its limit
         if (row + 8 <= endRow && (std::memcpy(&eight, &over[row], 8), eight == 0)) {
             row += 7;
@@ -635,8 +638,8 @@ int PeridynamicBonds::proposeBreaks(const std::vector<std::uint8_t>& over,
         for (unsigned bits = over[row]; bits != 0; bits &= bits - 1) {
             const int u = kPairTile * row + std::countr_zero(bits);
             if (u >= end) break;
-            const bool own = pairFirst_[u] >= slab_.begin && pairFirst_[u] < slab_.end;
-            if (!pairPad_[u] && own && alive[pairTwin_[u]]) {
+            const bool computed = pairFirst_[u] >= slab_.ghostBegin && pairFirst_[u] < slab_.end;
+            if (!pairPad_[u] && computed && alive[pairTwin_[u]]) {
                 proposed[pairTwin_[u]] = 1;
                 proposed[pairUpper_[u]] = 1;
                 breaking += 2;

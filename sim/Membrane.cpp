@@ -266,7 +266,9 @@ double Membrane::contactStepLimit() const {
 }
 
 void Membrane::accumulateForces() {
-    solver_->advance(stepState(), *workspace_, force_);
+    StepState s = stepState();
+    s.stiffeningNeeded = stiffeningNeeded();
+    solver_->advance(s, *workspace_, force_);
     stiffening_ = domain_ ? domain_->max(solver_->stiffening()) : solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
     if (contact_ && contact_->selfContact()) {
@@ -300,15 +302,29 @@ int Membrane::piecesOfStep() {
     const double contactPieces =
         contact_ && !adaptiveStep_ ? std::ceil(dt_ / contactStepLimit() * (1.0 - 1e-12)) : 1.0;
     if (stiffening_ <= 1.0 && contactPieces <= 1.0) return 1;
-    // The bound scales as 1/sqrt(stiffness). Keep dt / bound within what was allowed at rest:
-    // the safety factor, or the step's own ratio when it was set higher.
-    const double allowed = std::max(params_.time.safety, dt_ / stableDt_) * stableDt_;
-    const double needed =
-        std::max(contactPieces,
-                 std::ceil(dt_ * std::sqrt(std::max(1.0, stiffening_)) / allowed * (1.0 - 1e-12)));
+    const double needed = std::max(contactPieces, stiffeningPieces(stiffening_));
     const int pieces = int(std::clamp(needed, 1.0, double(kMaxPieces)));
     subSteps_ += pieces - 1;
     return pieces;
+}
+
+// The pieces a fixed step needs for a stiffening: the bound scales as 1/sqrt(stiffness). Keep
+// dt / bound within what was allowed at rest: the safety factor, or the step's own ratio when it
+// was set higher.
+double Membrane::stiffeningPieces(double stiffening) const {
+    const double allowed = std::max(params_.time.safety, dt_ / stableDt_) * stableDt_;
+    return std::ceil(dt_ * std::sqrt(std::max(1.0, stiffening)) / allowed * (1.0 - 1e-12));
+}
+
+// The largest stiffening that leaves a fixed step whole ((allowed / dt)^2, checked by
+// stiffeningPieces itself): any stiffening up to it gives piecesOfStep the same answer, so the
+// solver need not find it exactly (the power law's look-ahead then reads only the bonds that
+// could squash past it). An adaptive step's size follows the stiffening itself: 1.
+double Membrane::stiffeningNeeded() const {
+    if (adaptiveStep_ || !(dt_ > 0.0)) return 1.0;
+    const double allowed = std::max(params_.time.safety, dt_ / stableDt_) * stableDt_;
+    const double whole = (allowed / dt_) * (allowed / dt_);
+    return std::isfinite(whole) && whole > 1.0 && stiffeningPieces(whole) <= 1.0 ? whole : 1.0;
 }
 
 void Membrane::stepSymplecticEuler() {

@@ -197,6 +197,8 @@ private:
     void setUpContact(const MembraneParams& params);
     /// Pieces to cut this step into: sqrt of the power law's stiffening, capped.
     int piecesOfStep();
+    double stiffeningPieces(double stiffening) const;
+    double stiffeningNeeded() const;
     std::size_t breakCount() const;
     /// Refreshes the ghosts of x and v (decomposed runs only).
     void exchangeMotion();

@@ -59,6 +59,9 @@ struct LinearPairInput {
     /// Per pair (elastoplastic): the largest strain its bond has reached (BondLaw's
     /// PlasticState), moved on by advance() for the living, unbroken bonds.
     double* held = nullptr;
+    /// Per kPairTile pairs from a multiple of it, bit k: whether pair k's bond lives; read where
+    /// held is moved on and not allAlive.
+    const std::uint8_t* livingRows = nullptr;
     /// Per kPairTile pairs from a multiple of it (a vector, or two): where their ends are runs
     /// of consecutive particles, the first of each run (else -1); where their rest lengths,
     /// bond scales and limits are each one value, its class c >= 0 in the tables; where each is

@@ -190,6 +190,11 @@ private:
     mutable bool heldAhead_ = false, heldBehind_ = true;
     /// plastic_ from pairHeld_ where the pass moved it on.
     void syncHistory() const;
+    /// Per row of kTile pairs, bit k: whether lane k's bond lives (LinearPairInput::livingRows),
+    /// as of DamageState::version() livingVersion_.
+    mutable std::vector<std::uint8_t> livingRows_;
+    mutable std::uint64_t livingVersion_ = ~std::uint64_t(0);
+    const std::uint8_t* livingRows() const;
     std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
     std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
     std::vector<double> ratioFactor_;      ///< per bond, c*/c over the law's (maps); empty: all 1

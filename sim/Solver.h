@@ -38,6 +38,9 @@ struct StepState {
     std::span<const Eigen::Vector3d> v;  ///< velocities; empty where only forces are asked
     std::span<const double> theta;       ///< the diffusing quantity; empty without diffusion
     double dt = 0.0;                     ///< the step about to be taken [s]
+    /// stiffening() need be exact only above this (>= 1): a fixed step stays whole for any
+    /// stiffening up to it, so a solver may report it for anything less (Membrane::piecesOfStep).
+    double stiffeningNeeded = 1.0;
 };
 
 /// What Membrane::failureApproachRate measures a step by (its constants).

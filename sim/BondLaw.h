@@ -96,7 +96,26 @@ struct BondLaw {
         if (k == 1.0) return s;
         if (k == 2.0) return s * s;
         if (k == 3.0) return s * s * s;
+        if (k == 4.0) return (s * s) * (s * s);
         return std::pow(s, k);
+    }
+
+    /// Eq. 19's force as numerator / cube, cube = s^3: 2C (s^4 - 1) + C* n (s^(n-1) - 1) s^3
+    /// over s^3, which is 2C (s - 1/s^3) + C* n (s^(n-1) - 1). The pair kernels divide the
+    /// force by the bond's length and the numerator by length x cube: one division where there
+    /// were two. s^4 - 1 and, for the whole n of 2 to 4, s^(n-1) - 1 are factored by
+    /// e = s - 1, without the cancellation of their differences near s = 1.
+    struct PowerLawParts {
+        double numerator, cube;
+    };
+    PowerLawParts powerLawParts(double eta) const {
+        const double e = std::max(eta, kMostCompression), s = 1.0 + e, s2 = s * s;
+        const double cube = s2 * s, quartic = e * (s + 1.0) * (s2 + 1.0);
+        const double higher = powerN == 2.0   ? e
+                              : powerN == 3.0 ? e * (s + 1.0)
+                              : powerN == 4.0 ? e * (s2 + s + 1.0)
+                                              : power(s, powerN - 1.0) - 1.0;
+        return {2.0 * powerC * quartic + powerCStar * powerN * higher * cube, cube};
     }
 
     /// Eq. 20's force on the loading path at strain eta >= eta0 (lawExp: the vector kernels'
@@ -128,10 +147,8 @@ struct BondLaw {
             // linearly). Eq. 19 holds for s > 0 only: where the expansion alpha theta exceeds a
             // squashed bond's length, s = 1 + eta < 0 and s - 1/s^3 turns the push into a pull
             // that collapses the pair (the acid film's swollen shreds did).
-            eta = std::max(eta, kMostCompression);
-            const double s = 1.0 + eta;  // eq. 19
-            return 2.0 * powerC * (s - 1.0 / (s * s * s)) +
-                   powerCStar * powerN * (power(s, powerN - 1.0) - 1.0);
+            const PowerLawParts parts = powerLawParts(eta);  // eq. 19
+            return parts.numerator / parts.cube;
         } else {
             if (eta >= p.maxStrain && eta > yieldStrain) return yieldForce(eta);  // eq. 20
             return c * (eta - plasticStrain(p));  // elastic, below the largest strain

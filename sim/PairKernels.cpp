@@ -46,7 +46,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         const double rz = x[3 * j + 2] - x[3 * i + 2];
         const double length = std::sqrt(rx * rx + ry * ry + rz * rz);
         double eta = length / in.restLength[u] - 1.0;  // eq. 10
-        double thetaBar = 0.0, f;
+        double thetaBar = 0.0, f, cube = 1.0;
         if constexpr (kTheta) {
             thetaBar = 0.5 * (theta[i] + theta[j]);
             eta -= in.expansion * thetaBar;
@@ -77,9 +77,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
                 if constexpr (kTheta) tangent *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
                 stiffest = std::max(stiffest, tangent);
             }
-            const double s = 1.0 + std::max(eta, kMostCompression);
-            f = 2.0 * in.powerC * (s - 1.0 / (s * s * s)) +
-                in.powerCStar * in.powerN * (wholePower(s, in.powerN - 1.0) - 1.0);
+            const BondLaw::PowerLawParts parts = in.law->powerLawParts(eta);
+            f = parts.numerator, cube = parts.cube;                 // divided by below
         } else if constexpr (kLaw == BondLawKind::Elastoplastic) {  // eq. 20
             const PlasticState state = in.law->yieldStep(eta, PlasticState{in.held[u]});
             if (kUpdate && !past && in.alive[in.upper[u]]) in.held[u] = state.maxStrain;
@@ -88,7 +87,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             f = in.c * eta;  // eq. 18
         }
         if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
-        double coef = in.scale[u] * f / length;
+        double coef = in.scale[u] * f / (kLaw == BondLawKind::PowerLaw ? length * cube : length);
         if constexpr (kBreak) coef = past ? 0.0 : coef;
         double* slot = force + slotAt(unsigned(u - base), out.rows);
         const int stride = slotStride(out.rows);

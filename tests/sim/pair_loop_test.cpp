@@ -83,9 +83,13 @@ std::vector<Eigen::Vector3d> bothCopies(const PeridynamicBonds& solver, const Bo
             if (!theta.empty()) eta -= material.expansion() * thetaBar;
             if (eta > solver.criticalStretch() * material.strengthFactor(thetaBar)) continue;
             const BondLaw& law = solver.law();
-            double f = law.force(eta, law.yieldStep(eta, {}));
+            // The power law's force as its numerator, its cube divided by with the length
+            // (BondLaw::powerLawParts).
+            const bool power = law.kind == BondLawKind::PowerLaw;
+            const BondLaw::PowerLawParts parts = law.powerLawParts(eta);
+            double f = power ? parts.numerator : law.force(eta, law.yieldStep(eta, {}));
             if (!theta.empty()) f *= material.stiffnessFactor(thetaBar);
-            force[i] += (solver.bondScale(b) * f / length) * r;
+            force[i] += (solver.bondScale(b) * f / (power ? length * parts.cube : length)) * r;
         }
     return force;
 }

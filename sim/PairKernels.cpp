@@ -45,16 +45,21 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         const double ry = x[3 * j + 1] - x[3 * i + 1];
         const double rz = x[3 * j + 2] - x[3 * i + 2];
         const double length = std::sqrt(rx * rx + ry * ry + rz * rz);
-        double eta = length / in.restLength[u] - 1.0;  // eq. 10
+        // Eq. 10; the linear law's times rest (sim/PairKernelSimd.inc's kByRest).
+        constexpr bool kByRest = kLaw == BondLawKind::Linear;
+        const double rest = in.restLength[u];
+        double eta = kByRest ? length - rest : length / rest - 1.0;
         double thetaBar = 0.0, f, cube = 1.0;
         if constexpr (kTheta) {
             thetaBar = 0.5 * (theta[i] + theta[j]);
-            eta -= in.expansion * thetaBar;
+            const double swelling = in.expansion * thetaBar;
+            eta -= kByRest ? rest * swelling : swelling;
         }
         bool past = false;
         if constexpr (kBreak) {  // eqs. 27-28
             double limit = in.limit[u];
             if constexpr (kTheta) limit *= std::max(0.0, 1.0 - in.strengthLoss * thetaBar);
+            if constexpr (kByRest) limit = rest * limit;
             past = eta > limit;
             const unsigned bit = unsigned(u) % kPairTile;
             std::uint8_t& row = over[u / kPairTile];
@@ -87,7 +92,10 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             f = in.c * eta;  // eq. 18
         }
         if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
-        double coef = in.scale[u] * f / (kLaw == BondLawKind::PowerLaw ? length * cube : length);
+        double coef = in.scale[u] * f /
+                      (kByRest                         ? rest * length
+                       : kLaw == BondLawKind::PowerLaw ? length * cube
+                                                       : length);
         if constexpr (kBreak) coef = past ? 0.0 : coef;
         double* slot = force + slotAt(unsigned(u - base), out.rows);
         const int stride = slotStride(out.rows);

@@ -77,19 +77,25 @@ std::vector<Eigen::Vector3d> bothCopies(const PeridynamicBonds& solver, const Bo
             if (!damage.bondAlive()[b]) continue;
             const int j = bonds.partners[b];
             const Eigen::Vector3d r = x[j] - x[i];
-            const double length = r.norm();
-            double eta = length / bonds.restLength[b] - 1.0;
-            const double thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[i] + theta[j]);
-            if (!theta.empty()) eta -= material.expansion() * thetaBar;
-            if (eta > solver.criticalStretch() * material.strengthFactor(thetaBar)) continue;
+            const double length = r.norm(), rest = bonds.restLength[b];
             const BondLaw& law = solver.law();
+            // The linear law's strain times rest (no division), its limit times rest, its
+            // force over the length divided by rest x length.
+            const bool byRest = law.kind == BondLawKind::Linear;
+            double eta = byRest ? length - rest : length / rest - 1.0;
+            const double thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[i] + theta[j]);
+            const double swelling = material.expansion() * thetaBar;
+            if (!theta.empty()) eta -= byRest ? rest * swelling : swelling;
+            const double limit = solver.criticalStretch() * material.strengthFactor(thetaBar);
+            if (eta > (byRest ? rest * limit : limit)) continue;
             // The power law's force as its numerator, its cube divided by with the length
             // (BondLaw::powerLawParts).
             const bool power = law.kind == BondLawKind::PowerLaw;
             const BondLaw::PowerLawParts parts = law.powerLawParts(eta);
             double f = power ? parts.numerator : law.force(eta, law.yieldStep(eta, {}));
             if (!theta.empty()) f *= material.stiffnessFactor(thetaBar);
-            force[i] += (solver.bondScale(b) * f / (power ? length * parts.cube : length)) * r;
+            const double over = byRest ? rest * length : power ? length * parts.cube : length;
+            force[i] += (solver.bondScale(b) * f / over) * r;
         }
     return force;
 }

@@ -118,6 +118,25 @@ struct BondLaw {
         return {2.0 * powerC * quartic + powerCStar * powerN * higher * cube, cube};
     }
 
+    /// The pair kernels' eq. 19, from the bond's stretch times its rest length (length - rest,
+    /// less rest alpha theta) for the whole n of 2 to 4: f / length = numerator / (denominator
+    /// length), where powerLawParts' numerator / cube is numerator / denominator with both
+    /// multiplied by rest^(n+2), so that no division is taken for eta: one in all.
+    struct PowerLawByRest {
+        double numerator, denominator;
+    };
+    PowerLawByRest powerLawByRest(double stretch, double rest) const {
+        const double e = std::max(stretch, rest * kMostCompression), s = rest + e;
+        const double s2 = s * s, cube = s2 * s, r2 = rest * rest;
+        const double quartic = e * (s + rest) * (s2 + r2);
+        const double higher = powerN == 2.0   ? e
+                              : powerN == 3.0 ? e * (s + rest)
+                                              : e * (s2 + s * rest + r2);
+        const double low = powerN == 2.0 ? 1.0 : powerN == 3.0 ? rest : r2;
+        const double high = powerN == 2.0 ? rest : powerN == 3.0 ? r2 : r2 * rest;
+        return {2.0 * powerC * quartic * low + powerCStar * powerN * higher * cube, high * cube};
+    }
+
     /// Eq. 20's force on the loading path at strain eta >= eta0 (lawExp: the vector kernels'
     /// bits).
     double yieldForce(double eta) const {

@@ -45,8 +45,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         const double ry = x[3 * j + 1] - x[3 * i + 1];
         const double rz = x[3 * j + 2] - x[3 * i + 2];
         const double length = std::sqrt(rx * rx + ry * ry + rz * rz);
-        // Eq. 10; the linear law's times rest (sim/PairKernelSimd.inc's kByRest).
-        constexpr bool kByRest = kLaw == BondLawKind::Linear;
+        // Eq. 10; the linear and power laws' times rest (sim/PairKernelSimd.inc's kByRest).
+        constexpr bool kByRest = kLaw == BondLawKind::Linear || kLaw == BondLawKind::PowerLaw;
         const double rest = in.restLength[u];
         double eta = kByRest ? length - rest : length / rest - 1.0;
         double thetaBar = 0.0, f, cube = 1.0;
@@ -72,8 +72,9 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
                     (rx * (v[3 * j] - v[3 * i]) + ry * (v[3 * j + 1] - v[3 * i + 1]) +
                      rz * (v[3 * j + 2] - v[3 * i + 2])) /
                     (length * in.restLength[u]);
+                const double strain = eta / rest;
                 const double s =
-                    1.0 + std::max(eta + std::min(0.0, in.dt * rate), kMostCompression);
+                    1.0 + std::max(strain + std::min(0.0, in.dt * rate), kMostCompression);
                 const double s2 = s * s;
                 double tangent = (2.0 * in.powerC * (1.0 + 3.0 / (s2 * s2)) +
                                   in.powerCStar * in.powerN * (in.powerN - 1.0) *
@@ -82,8 +83,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
                 if constexpr (kTheta) tangent *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
                 stiffest = std::max(stiffest, tangent);
             }
-            const BondLaw::PowerLawParts parts = in.law->powerLawParts(eta);
-            f = parts.numerator, cube = parts.cube;                 // divided by below
+            const BondLaw::PowerLawByRest parts = in.law->powerLawByRest(eta, rest);
+            f = parts.numerator, cube = parts.denominator;          // divided by below
         } else if constexpr (kLaw == BondLawKind::Elastoplastic) {  // eq. 20
             const PlasticState state = in.law->yieldStep(eta, PlasticState{in.held[u]});
             if (kUpdate && !past && in.alive[in.upper[u]]) in.held[u] = state.maxStrain;
@@ -93,8 +94,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         }
         if constexpr (kTheta) f *= std::max(0.0, 1.0 - in.stiffnessLoss * thetaBar);
         double coef = in.scale[u] * f /
-                      (kByRest                         ? rest * length
-                       : kLaw == BondLawKind::PowerLaw ? length * cube
+                      (kLaw == BondLawKind::Linear     ? rest * length
+                       : kLaw == BondLawKind::PowerLaw ? cube * length
                                                        : length);
         if constexpr (kBreak) coef = past ? 0.0 : coef;
         double* slot = force + slotAt(unsigned(u - base), out.rows);

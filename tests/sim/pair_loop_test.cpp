@@ -79,22 +79,22 @@ std::vector<Eigen::Vector3d> bothCopies(const PeridynamicBonds& solver, const Bo
             const Eigen::Vector3d r = x[j] - x[i];
             const double length = r.norm(), rest = bonds.restLength[b];
             const BondLaw& law = solver.law();
-            // The linear law's strain times rest (no division), its limit times rest, its
-            // force over the length divided by rest x length.
-            const bool byRest = law.kind == BondLawKind::Linear;
+            // The linear and power laws' strain times rest (no division), their limit times
+            // rest, their force over the length divided once (BondLaw::powerLawByRest).
+            const bool power = law.kind == BondLawKind::PowerLaw;
+            const bool byRest = law.kind == BondLawKind::Linear || power;
             double eta = byRest ? length - rest : length / rest - 1.0;
             const double thetaBar = theta.empty() ? 0.0 : 0.5 * (theta[i] + theta[j]);
             const double swelling = material.expansion() * thetaBar;
             if (!theta.empty()) eta -= byRest ? rest * swelling : swelling;
             const double limit = solver.criticalStretch() * material.strengthFactor(thetaBar);
             if (eta > (byRest ? rest * limit : limit)) continue;
-            // The power law's force as its numerator, its cube divided by with the length
-            // (BondLaw::powerLawParts).
-            const bool power = law.kind == BondLawKind::PowerLaw;
-            const BondLaw::PowerLawParts parts = law.powerLawParts(eta);
+            const BondLaw::PowerLawByRest parts = law.powerLawByRest(eta, rest);
             double f = power ? parts.numerator : law.force(eta, law.yieldStep(eta, {}));
             if (!theta.empty()) f *= material.stiffnessFactor(thetaBar);
-            const double over = byRest ? rest * length : power ? length * parts.cube : length;
+            const double over = power    ? parts.denominator * length
+                                : byRest ? rest * length
+                                         : length;
             force[i] += (solver.bondScale(b) * f / over) * r;
         }
     return force;
@@ -197,7 +197,8 @@ double lookAheadOverBonds(const PeridynamicBonds& solver, const BondFamilies& bo
             if (!damage.bondAlive()[b]) continue;
             const int j = bonds.partners[b];
             const Eigen::Vector3d r = x[j] - x[i];
-            const double eta = r.norm() / bonds.restLength[b] - 1.0;
+            // The strain as the kernels take it where they look ahead: (length - rest) / rest.
+            const double eta = (r.norm() - bonds.restLength[b]) / bonds.restLength[b];
             if (!(eta < 0.0)) continue;
             const double rate = r.dot(v[j] - v[i]) / (r.norm() * bonds.restLength[b]);
             const double t =

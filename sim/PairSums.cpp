@@ -394,12 +394,33 @@ template <int kBonds>
     for (; alone != 0; alone &= alone - 1) gatherParticle(g, kTile * t + std::countr_zero(alone));
 }
 
+/// The rows and life flags of tile t, asked for now. On a sheet that streams from memory the
+/// hardware's prefetchers, following a dozen other streams, left the rows' reads waiting
+/// (10^6 particles, power law: 11.8 -> 11.3 ns per particle-step; 10^4: the same).
+[[REND_TILE_TARGET]] inline void prefetchTile(const PairGather& g, const PairSumTiles& s, int t) {
+    const PairSumTiles::Group& first = s.groups[s.groupFirst[t]];
+    if (first.lower == PairSumTiles::kUnion) {
+        __builtin_prefetch(s.unionRows.data() + first.rowFirst);
+    } else if (first.bonds > 0) {
+        const char* rows = reinterpret_cast<const char*>(s.rows.data() + first.rowFirst);
+        __builtin_prefetch(rows);
+        __builtin_prefetch(rows + 64);  // a tile's eight rows: 96 bytes
+    }
+    __builtin_prefetch(g.alive + g.offsets[kTile * t]);
+}
+
 [[REND_TILE_TARGET]] void gatherTiles(const PairGather& input, int begin, int end) {
+    constexpr int kTilesAhead = 16;
     const PairGather g = input;  // its own copy: the force stores cannot alias it
+    const PairSumTiles& s = *g.tiles;
+    const int lastTile = int(s.groupFirst.size()) - 2;
     int i = begin;
     for (; i < end && i % kTile != 0; ++i) gatherParticle(g, i);
     const bool stream = writesAround(g);
-    for (; i + kTile <= end; i += kTile) sumTile(g, *g.tiles, i / kTile, stream);
+    for (; i + kTile <= end; i += kTile) {
+        prefetchTile(g, s, std::min(i / kTile + kTilesAhead, lastTile));
+        sumTile(g, s, i / kTile, stream);
+    }
     for (; i < end; ++i) gatherParticle(g, i);
     if (stream) _mm_sfence();  // the streamed stores before any other thread's reads
 }

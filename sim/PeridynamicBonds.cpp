@@ -596,9 +596,13 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         bool skipFar = false;
         int block = 0;
         const bool lookAhead = in.update && law_.kind == BondLawKind::PowerLaw;
-        const auto compute = [&](LinearPairInput input, int p, int q) {
+        // The thread's own copies (328 bytes each), taken once per step rather than per block:
+        // each block sets what it changes.
+        LinearPairInput own = in, ghosts = halo;
+        const auto compute = [&](LinearPairInput& input, int p, int q) {
             double most = std::max(needed, stiffest);
             int near = 0;
+            input.lookAheadSlack = in.lookAheadSlack, input.skipFar = in.skipFar;
             if (input.update && lookAhead && (skipFar || block++ % kProbe == 0)) {
                 input.lookAheadSlack = lookAheadSlack(speeds.over(p, q + reach_), s.dt);
                 input.skipFar = true;
@@ -616,7 +620,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             if (input.skipFar) skipFar = kNearShare * near * simdWidth() < end - first;
             return most;
         };
-        compute(halo, tileStart(std::max(slab_.ghostBegin, from - reach_)), from);
+        compute(ghosts, tileStart(std::max(slab_.ghostBegin, from - reach_)), from);
 #pragma omp barrier
         PairGather gather{bonds_.offsets.data(),
                           pairs_.upperBegin.data(),
@@ -630,7 +634,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                           streamsForces(slab_.end - slab_.ghostBegin)};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
-            stiffest = std::max(stiffest, compute(in, p, q));
+            // The first pair of the block after next, asked for now: on a sheet that streams
+            // from memory, pairsBefore()'s read had missed every cache once per block (10^6
+            // particles, power law: 3.2% of the samples in this loop's own code, then 0.4%).
+            __builtin_prefetch(&tileBegin_[std::min(q + 2 * kFusedBlock, n) / kTile]);
+            stiffest = std::max(stiffest, compute(own, p, q));
             gatherPairForces(gather, std::max(p, slab_.begin), q);
         }
     }

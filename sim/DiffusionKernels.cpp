@@ -3,8 +3,11 @@
 #include <immintrin.h>
 
 #include <algorithm>
-#include <cstring>
+#include <bit>
+#include <map>
+#include <optional>
 
+#include "sim/RowSteps.h"
 #include "sim/StepKernels.h"
 
 namespace rend::sim {
@@ -43,7 +46,6 @@ DiffusionTiles DiffusionTiles::build(const BondFamilies& bonds, const std::vecto
     }
     const int slots = d.tileBegin[tiles];
     d.partner.assign(slots, 0), d.bond.assign(slots, -1), d.rate.assign(slots, 0.0);
-    d.living.assign(slots, 0);
     for (int t = 0; t < tiles; ++t) {
         const std::vector<int> offsets = unionOffsets(bonds, t);
         const int rows = (d.tileBegin[t + 1] - d.tileBegin[t]) / kTile;
@@ -65,12 +67,56 @@ DiffusionTiles DiffusionTiles::build(const BondFamilies& bonds, const std::vecto
             }
         }
     }
+    d.setUpRows();
     return d;
+}
+
+// Each row's run and rate class. A pad's rate does not count (its lane is masked off): it takes
+// the row's first bond's for the steps.
+void DiffusionTiles::setUpRows() {
+    const int rows = int(partner.size()) / kTile;
+    rowRun.assign(rows, -1), rowClass.assign(rows, -1), rateSteps.assign(partner.size(), 0);
+    livingRows.assign(rows, 0);
+    classRate.clear(), classUnit.clear();
+    std::map<std::uint64_t, int> classes;
+    for (int row = 0; row < rows; ++row) {
+        const int u = kTile * row;
+        bool run = true;
+        for (int l = 1; l < kTile; ++l) run = run && partner[u + l] == partner[u] + l;
+        if (run) rowRun[row] = partner[u];
+        double values[kTile];
+        int real = -1;
+        for (int l = 0; l < kTile && real < 0; ++l)
+            if (bond[u + l] >= 0) real = l;
+        if (real < 0) continue;  // only pads: the per-slot rates (zeros), never summed
+        for (int l = 0; l < kTile; ++l) values[l] = rate[u + (bond[u + l] >= 0 ? l : real)];
+        const std::optional<RowSteps> steps = rowSteps(values, &rateSteps[u]);
+        if (!steps) continue;
+        const auto [at, added] = classes.try_emplace(std::bit_cast<std::uint64_t>(steps->smallest),
+                                                     int(classRate.size()));
+        if (added) classRate.push_back(steps->smallest), classUnit.push_back(steps->unit);
+        rowClass[row] = steps->stepped ? kSteppedRate - at->second : at->second;
+    }
+}
+
+int DiffusionTiles::runRows() const {
+    return int(std::count_if(rowRun.begin(), rowRun.end(), [](int r) { return r >= 0; }));
+}
+
+int DiffusionTiles::classedRows() const {
+    return int(std::count_if(rowClass.begin(), rowClass.end(), [](int c) { return c != -1; }));
 }
 
 void DiffusionTiles::refresh(const std::uint8_t* alive, std::uint64_t version) {
     if (version == livingVersion) return;
-    for (std::size_t u = 0; u < bond.size(); ++u) living[u] = bond[u] >= 0 && alive[bond[u]];
+    for (std::size_t row = 0; row < livingRows.size(); ++row) {
+        unsigned bits = 0;
+        for (int l = 0; l < kTile; ++l) {
+            const int b = bond[kTile * row + l];
+            bits |= unsigned(b >= 0 && alive[b]) << l;
+        }
+        livingRows[row] = std::uint8_t(bits);
+    }
     livingVersion = version;
 }
 
@@ -80,7 +126,7 @@ void diffuseParticle(const DiffusionTiles& d, const double* theta, double* next,
     const double own = theta[i];
     double flux = 0.0;
     for (int u = d.tileBegin[t] + i % kTile; u < d.tileBegin[t + 1]; u += kTile)
-        if (d.living[u]) flux += d.rate[u] * (theta[d.partner[u]] - own);
+        if (d.living(u)) flux += d.rate[u] * (theta[d.partner[u]] - own);
     next[i] = own + dt * flux;
 }
 
@@ -92,12 +138,16 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
 }
 
 #if defined(__x86_64__)
-/// Whether index[0..lanes) are consecutive.
-[[gnu::target("avx2")]] inline bool consecutive8(const int* index) {
-    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
-    const __m256i run =
-        _mm256_add_epi32(_mm256_set1_epi32(index[0]), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    return unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi32(at, run))) == 0xffffffffu;
+/// A row's rates: its class's, its class's plus each slot's steps of the unit, or its own.
+[[gnu::target("avx2,avx512f")]] inline __m512d rowRates(const DiffusionTiles& d, int row) {
+    const int c = d.rowClass[row], u = DiffusionTiles::kTile * row;
+    if (c >= 0) return _mm512_set1_pd(d.classRate[c]);
+    if (c == -1) return _mm512_loadu_pd(d.rate.data() + u);
+    const int k = DiffusionTiles::kSteppedRate - c;
+    const __m512d steps = _mm512_cvtepi32_pd(_mm256_cvtepu16_epi32(
+        _mm_loadu_si128(reinterpret_cast<const __m128i*>(d.rateSteps.data() + u))));
+    return _mm512_add_pd(_mm512_set1_pd(d.classRate[k]),
+                         _mm512_mul_pd(steps, _mm512_set1_pd(d.classUnit[k])));
 }
 
 [[gnu::target("avx2,avx512f")]] void diffuseTilesAvx512(const DiffusionTiles& d,
@@ -105,26 +155,21 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
                                                         double dt, int firstTile, int lastTile) {
     const int* __restrict begin = d.tileBegin.data();
     const int* __restrict partner = d.partner.data();
-    const double* __restrict rate = d.rate.data();
-    const std::uint8_t* __restrict living = d.living.data();
+    const int* __restrict run = d.rowRun.data();
+    const std::uint8_t* __restrict living = d.livingRows.data();
     const __m512d step = _mm512_set1_pd(dt);
     for (int t = firstTile; t < lastTile; ++t) {
         const __m512d own = _mm512_loadu_pd(theta + 8 * t);
         __m512d flux = _mm512_setzero_pd();
-        for (int u = begin[t]; u < begin[t + 1]; u += 8) {
+        for (int row = begin[t] / 8; row < begin[t + 1] / 8; ++row) {
             const __m512d other =
-                consecutive8(partner + u)
-                    ? _mm512_loadu_pd(theta + partner[u])
+                run[row] >= 0
+                    ? _mm512_loadu_pd(theta + run[row])
                     : _mm512_i32gather_pd(
-                          _mm256_loadu_si256(reinterpret_cast<const __m256i*>(partner + u)), theta,
-                          8);
-            std::uint64_t bytes;
-            std::memcpy(&bytes, living + u, 8);
-            const __mmask8 alive = _mm512_cmpneq_epi64_mask(
-                _mm512_cvtepu8_epi64(_mm_cvtsi64_si128(bytes)), _mm512_setzero_si512());
-            const __m512d term =
-                _mm512_mul_pd(_mm512_loadu_pd(rate + u), _mm512_sub_pd(other, own));
-            flux = _mm512_mask_add_pd(flux, alive, flux, term);
+                          _mm256_loadu_si256(reinterpret_cast<const __m256i*>(partner + 8 * row)),
+                          theta, 8);
+            const __m512d term = _mm512_mul_pd(rowRates(d, row), _mm512_sub_pd(other, own));
+            flux = _mm512_mask_add_pd(flux, __mmask8(living[row]), flux, term);
         }
         _mm512_storeu_pd(next + 8 * t, _mm512_add_pd(own, _mm512_mul_pd(step, flux)));
     }
@@ -136,8 +181,9 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     const int* __restrict begin = d.tileBegin.data();
     const int* __restrict partner = d.partner.data();
     const double* __restrict rate = d.rate.data();
-    const std::uint8_t* __restrict living = d.living.data();
+    const std::uint8_t* __restrict living = d.livingRows.data();
     const __m256d step = _mm256_set1_pd(dt);
+    const __m256i laneBit = _mm256_setr_epi64x(1, 2, 4, 8);
     for (int t = firstTile; t < lastTile; ++t)
         for (int half = 0; half < 8; half += 4) {
             const __m256d own = _mm256_loadu_pd(theta + 8 * t + half);
@@ -145,11 +191,9 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
             for (int u = begin[t] + half; u < begin[t + 1]; u += 8) {
                 const __m256d other = _mm256_setr_pd(theta[partner[u]], theta[partner[u + 1]],
                                                      theta[partner[u + 2]], theta[partner[u + 3]]);
-                std::uint32_t bytes;
-                std::memcpy(&bytes, living + u, 4);
-                const __m256i wide = _mm256_cvtepu8_epi64(_mm_cvtsi32_si128(int(bytes)));
-                const __m256d alive = _mm256_castsi256_pd(_mm256_xor_si256(
-                    _mm256_cmpeq_epi64(wide, _mm256_setzero_si256()), _mm256_set1_epi64x(-1)));
+                const __m256i bits = _mm256_set1_epi64x(living[u / 8] >> half);
+                const __m256d alive = _mm256_castsi256_pd(
+                    _mm256_cmpeq_epi64(_mm256_and_si256(bits, laneBit), laneBit));
                 const __m256d term =
                     _mm256_mul_pd(_mm256_loadu_pd(rate + u), _mm256_sub_pd(other, own));
                 flux = _mm256_blendv_pd(flux, _mm256_add_pd(flux, term), alive);

@@ -15,17 +15,36 @@ namespace rend::sim {
 /// The bonds of a sheet in tiles of kTile particles.
 struct DiffusionTiles {
     static constexpr int kTile = 8;
-    std::vector<int> tileBegin;        ///< per tile, and one past the last: its first slot
-    std::vector<int> partner;          ///< per slot (tileBegin + kTile k + lane): j, or i for a pad
-    std::vector<int> bond;             ///< per slot: the directed bond, or -1 for a pad
-    std::vector<double> rate;          ///< per slot: the bond's rate, 0 for a pad
-    std::vector<std::uint8_t> living;  ///< per slot: the bond is alive (refresh())
+    std::vector<int> tileBegin;  ///< per tile, and one past the last: its first slot
+    std::vector<int> partner;    ///< per slot (tileBegin + kTile k + lane): j, or i for a pad
+    std::vector<int> bond;       ///< per slot: the directed bond, or -1 for a pad
+    std::vector<double> rate;    ///< per slot: the bond's rate, 0 for a pad
+    /// Per row of kTile slots (from a multiple of kTile): lane 0's partner where the row's
+    /// partners are consecutive, else -1; and where its rates (the pads' aside) are one value,
+    /// that class c >= 0 of classRate; where each is its class's plus whole steps of
+    /// classUnit (rateSteps, sim/RowSteps.h), kSteppedRate - c; else -1. On a regular lattice
+    /// the eight-lane sums then read an int and a byte or two per slot where they read thirteen
+    /// (10^6 particles stream them from memory every step).
+    std::vector<int> rowRun, rowClass;
+    std::vector<double> classRate, classUnit;
+    std::vector<std::uint16_t> rateSteps;
+    static constexpr int kSteppedRate = -2;
+    /// Per row, bit l: slot kTile row + l's bond lives (refresh()); 0 for a pad.
+    std::vector<std::uint8_t> livingRows;
     std::uint64_t livingVersion = ~std::uint64_t(0);
 
     /// The tiles of `bonds`, with `rate` per directed bond.
     static DiffusionTiles build(const BondFamilies& bonds, const std::vector<double>& rate);
-    /// Copies `alive` (per directed bond) into `living` when `version` has moved.
+    /// Copies `alive` (per directed bond) into `livingRows` when `version` has moved.
     void refresh(const std::uint8_t* alive, std::uint64_t version);
+    /// Whether slot u's bond lives (as of refresh()).
+    bool living(int u) const { return (livingRows[u / kTile] >> (u % kTile)) & 1u; }
+    /// How many rows are runs, and how many have a class (exact or stepped).
+    int runRows() const;
+    int classedRows() const;
+
+private:
+    void setUpRows();
 };
 
 /// next[i] = theta[i] + dt sum over living bonds of rate (theta_j - theta_i), particle i alone.

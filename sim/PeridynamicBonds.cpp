@@ -16,6 +16,7 @@
 #include "sim/PairKernels.h"
 #include "sim/PairSums.h"
 #include "sim/Parallel.h"
+#include "sim/RowSteps.h"
 #include "sim/SolverRegistry.h"
 #include "sim/StepKernels.h"
 
@@ -160,30 +161,6 @@ void PeridynamicBonds::setUpPairRows() {
 PeridynamicBonds::RowClasses PeridynamicBonds::rowClasses() const {
     RowClasses r;
     for (const int c : rowClass_) (c >= 0 ? r.exact : c == -1 ? r.perPair : r.stepped) += 1;
-    return r;
-}
-
-// A row's kTile values as its smallest plus steps (0-65535) of the smallest's last bit, each
-// checked to give the value's bits; nothing where one does not (NaN, values far apart).
-std::optional<PeridynamicBonds::RowSteps> PeridynamicBonds::rowSteps(const double* values,
-                                                                     std::uint16_t* steps) {
-    RowSteps r{*std::min_element(values, values + kTile), 0.0, false};
-    if (std::isfinite(r.smallest) && r.smallest != 0.0)
-        r.unit = std::ldexp(1.0, std::ilogb(r.smallest) - std::numeric_limits<double>::digits + 1);
-    std::uint16_t found[kTile];
-    for (int k = 0; k < kTile; ++k) {
-        if (std::bit_cast<std::uint64_t>(values[k]) == std::bit_cast<std::uint64_t>(r.smallest)) {
-            found[k] = 0;
-            continue;
-        }
-        const double count = r.unit > 0.0 ? std::round((values[k] - r.smallest) / r.unit) : -1.0;
-        if (!(count >= 1.0 && count <= 65535.0)) return std::nullopt;
-        const double back = r.smallest + count * r.unit;  // the kernels' expression
-        if (std::bit_cast<std::uint64_t>(back) != std::bit_cast<std::uint64_t>(values[k]))
-            return std::nullopt;
-        found[k] = std::uint16_t(count), r.stepped = true;
-    }
-    std::copy(found, found + kTile, steps);
     return r;
 }
 

@@ -161,11 +161,6 @@ private:
     std::vector<double> classRestUnit_, classScaleUnit_, classLimitUnit_;
     std::vector<std::uint16_t> pairRestSteps_, pairScaleSteps_, pairLimitSteps_;
     void setUpPairRows();
-    struct RowSteps {
-        double smallest, unit;
-        bool stepped;  ///< some value is not the smallest
-    };
-    static std::optional<RowSteps> rowSteps(const double* values, std::uint16_t* steps);
     PairSumTiles sumTiles_;  ///< the tiles whose sums run eight lanes wide (sim/PairSums.h)
     /// The first pair of the tile starting at particle p (a tile's first, or the particle count).
     int pairsBefore(int p) const { return tileBegin_[(p + kTile - 1) / kTile]; }

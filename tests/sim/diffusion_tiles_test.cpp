@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <tuple>
 #include <vector>
 
 #include "sim/DamageState.h"
@@ -51,16 +52,34 @@ std::vector<double> naiveStep(const BondFamilies& bonds, const std::vector<doubl
     return next;
 }
 
-class DiffusionTileSums : public ::testing::TestWithParam<LatticeKind> {};
+/// Per directed bond: a rate of its own (no row has a class), a lattice's (proportional to
+/// 1 / xi^2: a row of one direction is one value, or one plus whole steps of its last bit where
+/// the coordinates' rounding moves xi), or each a few such steps apart on purpose.
+enum class Rates { Random, Lattice, Stepped };
+
+std::vector<double> ratesOf(const Sheet& sheet, Rates kind) {
+    const BondFamilies& bonds = sheet.bonds;
+    std::vector<double> rate(bonds.directedCount());
+    for (std::size_t b = 0; b < rate.size(); ++b) {
+        const double xi = bonds.restLength[b];
+        rate[b] = kind == Rates::Random ? 10.0 * uniformFromHash(1, b) : 1e-3 / (xi * xi);
+        if (kind == Rates::Stepped)
+            rate[b] += double(b % 5) * std::ldexp(1.0, std::ilogb(rate[b]) - 52);
+    }
+    return rate;
+}
+
+class DiffusionTileSums : public ::testing::TestWithParam<std::tuple<LatticeKind, Rates>> {};
 
 TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
-    const Sheet sheet(GetParam());
+    const auto [lattice, rates] = GetParam();
+    const Sheet sheet(lattice);
     const BondFamilies& bonds = sheet.bonds;
     const int n = bonds.particleCount();
     ASSERT_NE(n % DiffusionTiles::kTile, 0);
-    std::vector<double> rate(bonds.directedCount()), theta(n);
+    const std::vector<double> rate = ratesOf(sheet, rates);
+    std::vector<double> theta(n);
     std::vector<std::uint8_t> alive(bonds.directedCount(), 1);
-    for (std::size_t b = 0; b < rate.size(); ++b) rate[b] = 10.0 * uniformFromHash(1, b);
     for (std::size_t b = 0; b < alive.size(); b += 13) alive[b] = 0;
     for (int i = 0; i < n; ++i) theta[i] = 1e3 * (uniformFromHash(2, i) - 0.3);
     DiffusionTiles tiles = DiffusionTiles::build(bonds, rate);
@@ -76,25 +95,37 @@ TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
     int differ = 0;
     for (int i = 0; i < n; ++i) differ += next[i] != expected[i];
     EXPECT_EQ(differ, 0) << "of " << n;
+    // Random rates leave every row its own; a lattice's give most rows a class, and the
+    // stepped ones most rows a stepped class (the sums above took those paths).
+    constexpr int kTile = DiffusionTiles::kTile;
+    const int allRows = tiles.tileBegin.back() / kTile;
+    int stepped = 0;
+    for (const int c : tiles.rowClass) stepped += c <= DiffusionTiles::kSteppedRate;
+    if (rates == Rates::Random) EXPECT_EQ(tiles.classedRows(), 0);
+    if (rates != Rates::Random) EXPECT_GT(tiles.classedRows(), allRows * 3 / 4);
+    if (rates == Rates::Stepped) EXPECT_GT(stepped, allRows / 2);
     // On the square sheet, away from its first and last two rows, every row of a tile is a run
     // of consecutive partners, the tiles across a lattice row's end too (a row per offset): no
     // row gathers its theta.
-    if (GetParam() != LatticeKind::Square) return;
-    constexpr int kTile = DiffusionTiles::kTile, kRow = 31;
+    if (lattice != LatticeKind::Square) return;
+    constexpr int kRow = 31;
     int rows = 0, runs = 0;
     for (int t = 2 * kRow / kTile + 1; kTile * (t + 1) + 2 * kRow < n; ++t)
         for (int u = tiles.tileBegin[t]; u < tiles.tileBegin[t + 1]; u += kTile) {
             bool run = true;
             for (int l = 0; l < kTile; ++l)
                 run = run && tiles.partner[u + l] == tiles.partner[u] + l;
+            EXPECT_EQ(tiles.rowRun[u / kTile], run ? tiles.partner[u] : -1);
             ++rows, runs += run;
         }
     EXPECT_GT(rows, 300);
     EXPECT_EQ(runs, rows);
 }
 
-INSTANTIATE_TEST_SUITE_P(Lattices, DiffusionTileSums,
-                         ::testing::Values(LatticeKind::Hexagonal, LatticeKind::Square));
+INSTANTIATE_TEST_SUITE_P(
+    Lattices, DiffusionTileSums,
+    ::testing::Combine(::testing::Values(LatticeKind::Hexagonal, LatticeKind::Square),
+                       ::testing::Values(Rates::Random, Rates::Lattice, Rates::Stepped)));
 
 // A diffusion that stepped before some bonds broke steps afterwards as one built on the broken
 // bonds does: its copy of which bonds live follows DamageState::version().

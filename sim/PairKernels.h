@@ -73,9 +73,9 @@ struct LinearPairInput {
     const double *classRest = nullptr, *classScale = nullptr, *classLimit = nullptr;
     const double *classRestUnit = nullptr, *classScaleUnit = nullptr, *classLimitUnit = nullptr;
     const std::uint16_t *restSteps = nullptr, *scaleSteps = nullptr, *limitSteps = nullptr;
-    /// How many particles ahead of a tile's first the kernels prefetch x (0: none), and how
-    /// many particles x holds.
-    int prefetchAhead = 0, particles = 0;
+    /// How many particles ahead of a tile's first the kernels prefetch x and theta (0: none),
+    /// and how many particles x holds; how many pairs held holds (its prefetch stays inside).
+    int prefetchAhead = 0, particles = 0, pairs = 0;
 };
 inline constexpr int kSteppedClass = -2;
 

@@ -476,6 +476,7 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
     in.runFirst = rowRunFirst_.data(), in.runSecond = rowRunSecond_.data();
     // Past the furthest partner, by about 24 KiB of positions (512 to 4,096 measured alike).
     in.prefetchAhead = reach_ + 1024, in.particles = int(s.x.size());
+    in.pairs = int(pairFirst_.size());
     in.uniform = rowClass_.data();
     in.classRest = classRest_.data(), in.classScale = classScale_.data();
     in.classLimit = classLimit_.data();

@@ -35,8 +35,6 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
     const int* __restrict second = in.second;
     const double* __restrict x = in.x;
     const double* __restrict theta = in.theta;
-    double* __restrict force = out.force;
-    const int base = out.slotBase;
     std::uint8_t* __restrict over = out.over;
     double stiffest = 1.0;
     for (int u = begin; u < end; ++u) {
@@ -98,8 +96,8 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
                        : kLaw == BondLawKind::PowerLaw ? cube * length
                                                        : length);
         if constexpr (kBreak) coef = past ? 0.0 : coef;
-        double* slot = force + slotAt(unsigned(u - base), out.rows);
-        const int stride = slotStride(out.rows);
+        double* slot = out.slot(u);
+        const int stride = out.slotStep();
         slot[0] = coef * rx, slot[stride] = coef * ry, slot[2 * stride] = coef * rz;
         if (!out.rows) slot[3] = 0.0;
     }
@@ -244,7 +242,7 @@ struct Simd {
         z = _mm256_setr_pd(a[2], b[2], c[2], d[2]);
     }
     /// Four x y z 0 slots from the lanes of x, of y and of z.
-    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz) {
+    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz, int) {
         const V zero = _mm256_setzero_pd();
         const V xy02 = _mm256_unpacklo_pd(fx, fy), xy13 = _mm256_unpackhi_pd(fx, fy);
         const V z02 = _mm256_unpacklo_pd(fz, zero), z13 = _mm256_unpackhi_pd(fz, zero);
@@ -340,10 +338,10 @@ struct Simd {
         x = join(x0, x1), y = join(y0, y1), z = join(z0, z1);
     }
     /// The lanes' x, y and z in their row's slots (eight lanes: the slots are in rows).
-    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz) {
+    [[gnu::always_inline]] static void storeSlots(double* slot, V fx, V fy, V fz, int stride) {
         _mm512_storeu_pd(slot, fx);
-        _mm512_storeu_pd(slot + kPairTile, fy);
-        _mm512_storeu_pd(slot + 2 * kPairTile, fz);
+        _mm512_storeu_pd(slot + stride, fy);
+        _mm512_storeu_pd(slot + 2 * stride, fz);
     }
 };
 

@@ -93,14 +93,26 @@ inline int slotStride(bool rows) { return rows ? kPairTile : 1; }
 bool slotRows();
 
 struct LinearPairOutput {
-    /// Pair u's force on i at slotAt(u - slotBase, rows): zero past its limit. slotBase is a
-    /// multiple of kPairTile.
+    /// Pair u's force on i at slotAt(u - slotBase, rows), or, with rowSlot, x at
+    /// rowSlot[u / kPairTile] + u % kPairTile and y, z `stride` and twice that after: zero past
+    /// its limit. slotBase is a multiple of kPairTile.
     double* force = nullptr;
     /// Per row of kPairTile pairs (only with a limit): bit u % kPairTile of byte u / kPairTile,
     /// pair u is past its limit. The kernels take rows whole: begin is a multiple of kPairTile.
     std::uint8_t* over = nullptr;
     int slotBase = 0;
     bool rows = false;  ///< slotRows()
+    /// In rows, per row of kPairTile pairs: where its lane 0's x lies (PeridynamicBonds lays a
+    /// tile's k-th rows of consecutive tiles side by side, so that a particle's lower copies,
+    /// lanes of two tiles' rows, load as one run); null: slotAt(u - slotBase, rows).
+    const int* rowSlot = nullptr;
+    int stride = kPairTile;
+    /// Pair u's x; its y and z slotStep() and twice that after.
+    double* slot(int u) const {
+        return rowSlot ? force + rowSlot[u / kPairTile] + u % kPairTile
+                       : force + slotAt(unsigned(u - slotBase), rows);
+    }
+    int slotStep() const { return rowSlot ? stride : slotStride(rows); }
     /// With LinearPairInput::skipFar: the vectors with a compressed lane within its
     /// lookAheadSlack of the reach are added to it.
     int* nearRows = nullptr;

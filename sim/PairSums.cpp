@@ -18,18 +18,15 @@ constexpr int kTile = PairSumTiles::kTile;
 /// A group of one lane is summed as one particle: its rows would cost more than its own loop.
 constexpr int kFewestLanes = 2;
 
-/// Lanes [first, end)'s pairs of one row as at most two runs; false where they are not.
-bool rowOf(const int* pair, int first, int end, int& runA, int& runB, int& split) {
-    runA = pair[first] - first, split = end;
+/// Lanes [first, end)'s slots (where each one's x lies) of one row as at most two runs of
+/// consecutive slots; false where they are not.
+bool rowOf(const int* slot, int first, int end, int& runA, int& runB, int& split) {
+    runA = slot[first] - first, split = end;
     for (int l = first + 1; l < end && split == end; ++l)
-        if (pair[l] - l != runA) split = l;
-    runB = split < end ? pair[split] - split : runA;
-    for (int l = first; l < end; ++l) {
-        const int from = l < split ? first : split, run = l < split ? runA : runB;
-        // A run stays inside a group of eight slots, so it never wraps around a ring.
-        if (pair[l] < 0 || pair[l] - l != run || pair[l] / kTile != pair[from] / kTile)
-            return false;
-    }
+        if (slot[l] - l != runA) split = l;
+    runB = split < end ? slot[split] - split : runA;
+    for (int l = first; l < end; ++l)
+        if (slot[l] < 0 || slot[l] - l != (l < split ? runA : runB)) return false;
     return true;
 }
 
@@ -40,23 +37,22 @@ struct Shape {
 };
 
 /// Whether lanes [first, end) of tile t, of `bonds` bonds each, form a group; its rows if so.
-bool groupOf(const int* offsets, const int* pairOf, int t, int first, int end, int bonds,
+bool groupOf(const int* offsets, const int* slotOf, int t, int first, int end, int bonds,
              std::vector<int>& a, std::vector<int>& b, std::vector<int>& split) {
     a.resize(bonds), b.resize(bonds), split.resize(bonds);
     for (int k = 0; k < bonds; ++k) {
-        int pair[kTile] = {};
-        for (int l = first; l < end; ++l) pair[l] = pairOf[offsets[kTile * t + l] + k];
-        if (!rowOf(pair, first, end, a[k], b[k], split[k])) return false;
+        int slot[kTile] = {};
+        for (int l = first; l < end; ++l) slot[l] = slotOf[offsets[kTile * t + l] + k];
+        if (!rowOf(slot, first, end, a[k], b[k], split[k])) return false;
     }
     return true;
 }
 
 /// Tile t as one union group (PairSumTiles::kUnion): its rows appended to `rows`, or false
 /// where it cannot be (a lane's bonds not in increasing offset, more than 64 life flags, a row
-/// in more than three runs). `at(u, l)`: where lane 0's x would lie for lane l's pair u.
-template <class At>
-bool unionOf(const int* offsets, const int* upperBegin, const int* pairOf, const int* partners,
-             int t, At at, std::vector<PairSumTiles::UnionRow>& rows) {
+/// in more than three runs).
+bool unionOf(const int* offsets, const int* upperBegin, const int* slotOf, const int* partners,
+             int t, std::vector<PairSumTiles::UnionRow>& rows) {
     const int base = offsets[kTile * t];
     if (offsets[kTile * (t + 1)] - base > 64) return false;
     std::vector<int> all;
@@ -81,12 +77,11 @@ bool unionOf(const int* offsets, const int* upperBegin, const int* pairOf, const
             const int* end = partners + offsets[i + 1];
             const int* found = std::find(partners + offsets[i], end, i + d);
             if (found == end) continue;
-            const int b = int(found - partners), u = pairOf[b];
-            if (u < 0) return false;
+            const int b = int(found - partners), slot = slotOf[b];
+            if (slot < 0) return false;
             r.having |= std::uint8_t(1u << l), r.select |= std::uint64_t(1) << (b - base);
-            // A run stays inside a group of eight slots (so never wraps around a ring): lanes
-            // whose lane-0 positions agree are one run.
-            const int where = at(u, l);
+            // Lanes whose lane-0 positions agree are one run.
+            const int where = slot - l;
             int k = 0;
             while (k < runs && r.at[k] != where) ++k;
             if (k == runs) {
@@ -103,12 +98,10 @@ bool unionOf(const int* offsets, const int* upperBegin, const int* pairOf, const
 
 }  // namespace
 
-PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, const int* pairOf,
-                                 const int* partners, int n, unsigned slotMask) {
+PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, const int* slotOf,
+                                 const int* partners, int n) {
     PairSumTiles s;
-    s.slotMask = slotMask, s.directedBonds = offsets[n];
-    // Where lane 0's x would lie, for lane l's pair u: l before u's.
-    const auto at = [&](int u, int l) { return int(slotAt(unsigned(u) & slotMask, true)) - l; };
+    s.directedBonds = offsets[n];
     const int tiles = n / kTile;
     s.groupFirst.assign(tiles + 1, 0);
     std::vector<int> a, b, split;
@@ -122,16 +115,15 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
             const bool vector = own.bonds > 0 && own.bonds <= kMostBonds;
             end = first + 1;
             while (vector && end < kTile && shape(kTile * t + end) == own &&
-                   groupOf(offsets, pairOf, t, first, end + 1, own.bonds, a, b, split))
+                   groupOf(offsets, slotOf, t, first, end + 1, own.bonds, a, b, split))
                 ++end;
             Group group{std::uint8_t(first), std::uint8_t(end), 0, std::uint8_t(own.lower), -1};
             if (vector && end - first >= kFewestLanes &&
-                groupOf(offsets, pairOf, t, first, end, own.bonds, a, b, split)) {
+                groupOf(offsets, slotOf, t, first, end, own.bonds, a, b, split)) {
                 group.bonds = std::uint8_t(own.bonds), group.rowFirst = int(s.rows.size());
                 for (int k = 0; k < own.bonds; ++k) {
                     const unsigned lanes = ((1u << (end - first)) - 1u) << first;
-                    const int atA = at(a[k] + first, first);
-                    s.rows.push_back({atA, split[k] < end ? at(b[k] + split[k], split[k]) : atA,
+                    s.rows.push_back({a[k], split[k] < end ? b[k] : a[k],
                                       std::uint8_t(lanes & ((1u << split[k]) - 1u))});
                 }
             }
@@ -141,8 +133,7 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
         const Group& first = s.groups[s.groupFirst[t]];
         const bool whole = made == 1 && first.endLane == kTile && first.bonds > 0;
         const int before = int(s.unionRows.size());
-        if (!whole && partners &&
-            unionOf(offsets, upperBegin, pairOf, partners, t, at, s.unionRows)) {
+        if (!whole && partners && unionOf(offsets, upperBegin, slotOf, partners, t, s.unionRows)) {
             const int rows = int(s.unionRows.size()) - before;
             s.groups.resize(s.groupFirst[t]);
             s.groups.push_back(Group{0, std::uint8_t(kTile), std::uint8_t(rows), kUnion, before});
@@ -154,20 +145,21 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
 
 namespace {
 
-/// The slots of pair u: x, y slotStride() after, z twice that.
-inline const double* slotOf(const PairGather& g, int u) {
-    return g.pairForce + slotAt(unsigned(u) & g.slotMask, g.rows);
+/// The slots of directed bond b's pair: x, y slotStep() after, z twice that.
+inline const double* slotOf(const PairGather& g, int b) {
+    return g.pairForce +
+           (g.rows ? std::size_t(g.pairOf[b]) : slotAt(unsigned(g.pairOf[b]) & g.slotMask, false));
 }
 
 void gatherParticle(const PairGather& g, int i) {
-    const int stride = slotStride(g.rows);
+    const int stride = g.rows ? g.stride : slotStride(false);
     double sum[3] = {0.0, 0.0, 0.0};
     for (int b = g.offsets[i]; b < g.upperBegin[i]; ++b)
         if (g.alive[b])
-            for (int k = 0; k < 3; ++k) sum[k] -= slotOf(g, g.pairOf[b])[stride * k];
+            for (int k = 0; k < 3; ++k) sum[k] -= slotOf(g, b)[stride * k];
     for (int b = g.upperBegin[i]; b < g.offsets[i + 1]; ++b)
         if (g.alive[b])
-            for (int k = 0; k < 3; ++k) sum[k] += slotOf(g, g.pairOf[b])[stride * k];
+            for (int k = 0; k < 3; ++k) sum[k] += slotOf(g, b)[stride * k];
     for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
 }
 
@@ -204,7 +196,7 @@ struct GroupLife {
     }
 };
 
-/// One row's x (or y, z, kPairTile after) of its lanes: those of run A and those of run B, one
+/// One row's x (or y, z: the stride after) of its lanes: those of run A and those of run B, one
 /// masked load each. `a` and `b` point at the slots lane 0 would have in each run (a ring has
 /// kPairTile doubles before it); other lanes are zero.
 [[REND_TILE_TARGET]] inline __m512d rowLanes(const double* a, const double* b, __mmask8 fromA,
@@ -258,13 +250,12 @@ struct Lanes3 {
     const __mmask8 fromA = r.fromA, fromB = __mmask8(lanes & ~fromA);
     const __mmask8 on = __mmask8(living);
     __m512d fx, fy, fz;
-    if (fromA == 0xff) {  // a whole row of one run: an upper copy's row, inside a lattice
-        fx = _mm512_loadu_pd(a), fy = _mm512_loadu_pd(a + kPairTile);
-        fz = _mm512_loadu_pd(a + 2 * kPairTile);
+    const int y = g.stride, z = 2 * g.stride;
+    if (fromA == 0xff) {  // one run: an upper copy's row, or a lower one's inside a lattice
+        fx = _mm512_loadu_pd(a), fy = _mm512_loadu_pd(a + y), fz = _mm512_loadu_pd(a + z);
     } else {
-        fx = rowLanes(a, b, fromA, fromB),
-        fy = rowLanes(a + kPairTile, b + kPairTile, fromA, fromB);
-        fz = rowLanes(a + 2 * kPairTile, b + 2 * kPairTile, fromA, fromB);
+        fx = rowLanes(a, b, fromA, fromB), fy = rowLanes(a + y, b + y, fromA, fromB);
+        fz = rowLanes(a + z, b + z, fromA, fromB);
     }
     if (minus) {
         sum.x = _mm512_mask_sub_pd(sum.x, on, sum.x, fx);
@@ -305,8 +296,8 @@ template <int kBonds>
     for (int k = 0; k < kBonds; ++k) {
         const double *a = g.pairForce + row[k].atA, *b = g.pairForce + row[k].atB;
         const __mmask8 fromA = row[k].fromA, on = __mmask8(_pext_u64(life, kStride << k));
-        const __m512d fx = wholeRow(a, b, fromA, 0), fy = wholeRow(a, b, fromA, kPairTile);
-        const __m512d fz = wholeRow(a, b, fromA, 2 * kPairTile);
+        const __m512d fx = wholeRow(a, b, fromA, 0), fy = wholeRow(a, b, fromA, g.stride);
+        const __m512d fz = wholeRow(a, b, fromA, 2 * g.stride);
         if (k < lower) {
             x = _mm512_mask_sub_pd(x, on, x, fx), y = _mm512_mask_sub_pd(y, on, y, fy);
             z = _mm512_mask_sub_pd(z, on, z, fz);
@@ -342,8 +333,8 @@ template <int kBonds>
         const PairSumTiles::UnionRow& r = s.unionRows[q];
         const __mmask8 on = __mmask8(_pdep_u64(_pext_u64(life, r.select), r.having));
         const __m512d fx = unionLanes(g.pairForce, r, 0);
-        const __m512d fy = unionLanes(g.pairForce, r, kPairTile);
-        const __m512d fz = unionLanes(g.pairForce, r, 2 * kPairTile);
+        const __m512d fy = unionLanes(g.pairForce, r, g.stride);
+        const __m512d fz = unionLanes(g.pairForce, r, 2 * g.stride);
         if (r.minus) {
             x = _mm512_mask_sub_pd(x, on, x, fx), y = _mm512_mask_sub_pd(y, on, y, fy);
             z = _mm512_mask_sub_pd(z, on, z, fz);
@@ -456,8 +447,7 @@ template <int kBonds>
 void gatherPairForces(const PairGather& g, int begin, int end) {
 #if defined(__x86_64__)
     if (g.rows) {
-        if (g.tiles && g.tiles->slotMask == g.slotMask && simdWidth() == 8)
-            return gatherTiles(g, begin, end);
+        if (g.tiles && simdWidth() == 8) return gatherTiles(g, begin, end);
     } else if (simdWidth() >= 4) {
         return gatherAvx2(g, begin, end);
     }

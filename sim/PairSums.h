@@ -28,8 +28,8 @@ struct PairSumTiles {
     };
     std::vector<Group> groups;
     /// A row (the k-th bonds of a group's lanes side by side): where lane 0's x would lie in
-    /// each run's slots (lane l's is l after), for a ring of slotMask + 1 slots, and the lanes
-    /// whose pairs lie in run A (the rest in run B).
+    /// each run's slots (lane l's is l after), and the lanes whose pairs lie in run A (the rest
+    /// in run B).
     struct Row {
         int atA, atB;
         std::uint8_t fromA;
@@ -48,23 +48,24 @@ struct PairSumTiles {
         std::uint64_t select;  ///< those bonds' life flags among the tile's (one bit per lane)
     };
     std::vector<UnionRow> unionRows;
-    unsigned slotMask = ~0u;
     int directedBonds = 0;  ///< offsets[n]
 
-    /// The tiles of particles [0, n) from the CSR offsets, upper copies' starts, each directed
-    /// bond's pair and partner, for a ring of slotMask + 1 slots (a power of 2, at least kTile).
-    static PairSumTiles build(const int* offsets, const int* upperBegin, const int* pairOf,
-                              const int* partners, int n, unsigned slotMask);
+    /// The tiles of particles [0, n) from the CSR offsets, upper copies' starts, where each
+    /// directed bond's pair's x lies in the slots (PairGather::pairOf in rows; -1: none) and
+    /// each one's partner. A run is any eight consecutive slots.
+    static PairSumTiles build(const int* offsets, const int* upperBegin, const int* slotOf,
+                              const int* partners, int n);
 };
 
 struct PairGather {
     const int* offsets = nullptr;
     const int* upperBegin = nullptr;
-    const int* pairOf = nullptr;  ///< per directed bond: its pair u
+    /// Per directed bond: its pair u, or in rows where its pair's x lies in pairForce.
+    const int* pairOf = nullptr;
     const std::uint8_t* alive = nullptr;
-    /// LinearPairOutput::force: pair u at slotAt(u & slotMask, rows) (sim/PairKernels.h); in
-    /// rows, with kPairTile readable doubles before the first slot and after the last (read,
-    /// never summed).
+    /// LinearPairOutput::force: pair u at slotAt(u & slotMask, false) (sim/PairKernels.h); in
+    /// rows, x at pairOf, y and z `stride` and twice that after, with kPairTile readable
+    /// doubles before each and after (read, never summed).
     const double* pairForce = nullptr;
     double* force = nullptr;              ///< x y z per particle
     unsigned slotMask = ~0u;              ///< a ring of 2^k slots, or all bits: slot u is pair u
@@ -73,6 +74,7 @@ struct PairGather {
     /// The tile sums' stores bypass the caches (streamsForces()), where force lies on 64-byte
     /// lines (writesAround()).
     bool stream = false;
+    int stride = 8;  ///< in rows: from a slot's x to its y
 };
 
 /// Particles [begin, end).

@@ -113,8 +113,47 @@ void PeridynamicBonds::setUpPairArrays() {
                                       pairsBefore(tileStart(std::max(0, p - reach_))));
     ringPairs_ = 1;
     while (ringPairs_ < window) ringPairs_ *= 2;
-    sumTiles_ = PairSumTiles::build(bonds_.offsets.data(), pairs_.upperBegin.data(), slotOf_.data(),
-                                    bonds_.partners.data(), n, unsigned(ringPairs_ - 1));
+    if (slotRows()) setUpRowSlots();
+}
+
+// In rows: where each row's lane 0 lies in a thread's ring. On a sheet whose step fits the
+// caches, a ring of ringTiles_ tiles per row index k: the k-th rows of consecutive tiles lie side
+// by side, so that the lower copies of a tile's particles (lanes of two tiles' rows: a lattice's
+// neighbours d particles back are lanes d % 8 on) load as one run where they were two and a
+// blend. Each k's ring is a line longer than its tiles, so that k's rows do not lie a multiple of
+// 4 KiB apart (interleaved, crack_path_sources, 10^4 particles: linear 10.66 -> 10.49 ns,
+// elastoplastic 12.37 -> 12.11). On a sheet that streams from memory the rows stay in pair
+// order, placed by slotAt() without the table: by k, or by the table alone, 10^6 particles
+// took 13.0 -> 13.3.
+void PeridynamicBonds::setUpRowSlots() {
+    const int n = bonds_.particleCount(), tiles = int(tileBegin_.size()) - 1;
+    rowSlot_.assign(pairFirst_.size() / kTile, 0);
+    rowsByK_ = !streamsForces(n);
+    if (!rowsByK_) {  // pair u's x at slotAt(u & (ringPairs_ - 1)), as the kernels place it
+        rowStride_ = kPairTile, ringDoubles_ = 2 * kPairTile + 3 * ringPairs_;
+        for (std::size_t r = 0; r < rowSlot_.size(); ++r)
+            rowSlot_[r] = kSlotRow * int(r & std::size_t(ringPairs_ / kTile - 1));
+    } else {
+        int windowTiles = 1, rowsPerTile = 1;
+        for (int p = 0; p < n; p += kTile)
+            windowTiles = std::max(windowTiles, (std::min(n, p + kFusedBlock) + kTile - 1) / kTile -
+                                                    tileStart(std::max(0, p - reach_)) / kTile);
+        for (int t = 0; t < tiles; ++t)
+            rowsPerTile = std::max(rowsPerTile, (tileBegin_[t + 1] - tileBegin_[t]) / kTile);
+        int ringTiles = 1;
+        while (ringTiles < windowTiles) ringTiles *= 2;
+        const int ringOfK = kTile * (ringTiles + 1);
+        rowStride_ = rowsPerTile * ringOfK + kPairTile;  // x, then y, then z
+        ringDoubles_ = kPairTile + 3 * rowStride_;
+        for (int t = 0; t < tiles; ++t)
+            for (int k = 0; k < (tileBegin_[t + 1] - tileBegin_[t]) / kTile; ++k)
+                rowSlot_[tileBegin_[t] / kTile + k] = k * ringOfK + kTile * (t & (ringTiles - 1));
+    }
+    bondSlot_.assign(bonds_.directedCount(), -1);
+    for (std::size_t b = 0; b < bondSlot_.size(); ++b)
+        if (const int u = slotOf_[b]; u >= 0) bondSlot_[b] = rowSlot_[u / kTile] + u % kTile;
+    sumTiles_ = PairSumTiles::build(bonds_.offsets.data(), pairs_.upperBegin.data(),
+                                    bondSlot_.data(), bonds_.partners.data(), n);
 }
 
 // Per row of a tile (its particles' k-th pairs, side by side): whether its ends are two runs of
@@ -534,12 +573,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     const int n = bonds_.particleCount();
     force.resize(n);
     const int teams = n >= kParallelThreshold ? omp_get_max_threads() : 1;
-    // In rows, each ring has kPairTile doubles before and after it: the tile sums
-    // (sim/PairSums.h) read a row's lanes from a run's slot of lane 0, which may lie before the
-    // first slot, and read up to kPairTile - 1 past the last.
+    // In rows, each ring has kPairTile doubles before it and after x, y and z (setUpRowSlots):
+    // the tile sums (sim/PairSums.h) read a row's lanes from a run's slot of lane 0, which may
+    // lie before the first slot, and read up to kPairTile - 1 past the last.
     const bool rows = slotRows();
-    const std::size_t ringSize =
-        rows ? 2 * kPairTile + 3 * std::size_t(ringPairs_) : 4 * std::size_t(ringPairs_);
+    const std::size_t ringSize = rows ? std::size_t(ringDoubles_) : 4 * std::size_t(ringPairs_);
     work.slots.resize(ringSize * teams);
     if (kBreak) work.over.resize((pairFirst_.size() + kPairTile - 1) / kPairTile);
     const LinearPairInput in = pairInput(s, kUpdateBonds, kBreak);
@@ -591,6 +629,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                 const int stop = std::min(end, base + ringPairs_);
                 input.stiffestKnown = most;
                 LinearPairOutput out{ring, work.over.data(), base, rows};
+                if (rows && rowsByK_) out.rowSlot = rowSlot_.data(), out.stride = rowStride_;
                 out.nearRows = &near;
                 most = std::max(most, linearPairForces(input, out, u, stop));
                 u = stop;
@@ -602,14 +641,15 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
 #pragma omp barrier
         PairGather gather{bonds_.offsets.data(),
                           pairs_.upperBegin.data(),
-                          slotOf_.data(),
+                          rows ? bondSlot_.data() : slotOf_.data(),
                           damage_->bondAlive().data(),
                           ring,
                           force.data()->data(),
                           unsigned(ringPairs_ - 1),
                           &sumTiles_,
                           rows,
-                          streamsForces(slab_.end - slab_.ghostBegin)};
+                          streamsForces(slab_.end - slab_.ghostBegin),
+                          rowStride_};
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
             // The first pair of the block after next, asked for now: on a sheet that streams

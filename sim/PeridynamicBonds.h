@@ -169,6 +169,13 @@ private:
     int reach_ = 0;  ///< the largest i - j over bonds i -> j: how far back a lower copy lies
     int ringPairs_ =
         1;  ///< slots in each thread's ring: a power of 2 >= the pairs a block's sums need
+    /// In rows (setUpRowSlots): from a slot's x to its y, the doubles of each thread's ring,
+    /// where each row's lane 0 lies (per row of pairs) and each directed bond's pair (per bond;
+    /// -1: none).
+    int rowStride_ = kTile, ringDoubles_ = 0;
+    bool rowsByK_ = false;  ///< rowSlot_ by row index k; else in pair order (slotAt())
+    std::vector<int> rowSlot_, bondSlot_;
+    void setUpRowSlots();
     std::span<const Eigen::Vector3d> rest_;
     std::span<const double> volume_;
     Material material_;

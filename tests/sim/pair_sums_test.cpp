@@ -50,19 +50,51 @@ std::vector<int> tilePairs(const BondFamilies& bonds, const BondPairs& pairs) {
     return pairOf;
 }
 
+/// Where each directed bond's pair's x lies, and how far its y lies after, for slots in rows.
+struct Layout {
+    std::vector<int> slot;
+    int stride = kPairTile;
+};
+
+/// A ring of slotMask + 1 pairs in rows of eight (slotAt()).
+Layout ringOfPairs(const std::vector<int>& pairOf, unsigned slotMask) {
+    Layout l;
+    for (const int u : pairOf)
+        l.slot.push_back(u < 0 ? -1 : int(slotAt(unsigned(u) & slotMask, true)));
+    return l;
+}
+
+/// PeridynamicBonds' layout: the k-th rows of a ring of `ringTiles` consecutive tiles side by
+/// side, k by k, each k's ring a line longer than its tiles (pairs numbered as tilePairs()).
+Layout ringOfRows(const BondFamilies& bonds, const BondPairs& pairs, int ringTiles) {
+    const int n = bonds.particleCount(), ringOfK = kTile * (ringTiles + 1);
+    std::vector<int> rowSlot;
+    int most = 1;
+    for (int t = 0; t * kTile < n; ++t) {
+        int rows = 0;
+        for (int i = kTile * t; i < std::min(n, kTile * (t + 1)); ++i)
+            rows = std::max(rows, bonds.offsets[i + 1] - pairs.upperBegin[i]);
+        for (int k = 0; k < rows; ++k) rowSlot.push_back(k * ringOfK + kTile * (t % ringTiles));
+        most = std::max(most, rows);
+    }
+    Layout l;
+    for (const int u : tilePairs(bonds, pairs))
+        l.slot.push_back(u < 0 ? -1 : rowSlot[u / kTile] + u % kTile);
+    l.stride = most * ringOfK + kPairTile;
+    return l;
+}
+
 struct Sums {
-    explicit Sums(const BondFamilies& bonds, std::vector<int> pairs, unsigned slotMask)
+    explicit Sums(const BondFamilies& bonds, Layout layout)
         : bonds(bonds),
           pairs(buildBondPairs(bonds)),
-          pairOf(std::move(pairs)),
+          layout(std::move(layout)),
           alive(bonds.directedCount(), 1),
           tiles(PairSumTiles::build(bonds.offsets.data(), this->pairs.upperBegin.data(),
-                                    pairOf.data(), bonds.partners.data(), bonds.particleCount(),
-                                    slotMask)),
-          slotMask(slotMask) {
-        const int most = *std::max_element(pairOf.begin(), pairOf.end());
-        const unsigned used = std::min(unsigned(most), slotMask) + 1;
-        slots.assign(kTile + slotAt(used, true) + kSlotRow, 0.0);
+                                    this->layout.slot.data(), bonds.partners.data(),
+                                    bonds.particleCount())) {
+        const int last = *std::max_element(this->layout.slot.begin(), this->layout.slot.end());
+        slots.assign(kTile + 2 * std::size_t(this->layout.stride) + last + 2 * kTile, 0.0);
         for (std::size_t k = kTile; k < slots.size(); ++k)
             slots[k] = 2.0 * uniformFromHash(11, int(k)) - 1.0;
         for (int b = 0; b < int(alive.size()); ++b) {
@@ -79,14 +111,15 @@ struct Sums {
         while (reinterpret_cast<std::uintptr_t>(force) % 64 != 0) ++force;
         const PairGather g{bonds.offsets.data(),
                            pairs.upperBegin.data(),
-                           pairOf.data(),
+                           layout.slot.data(),
                            alive.data(),
                            slots.data() + kTile,
                            force,
-                           slotMask,
+                           ~0u,
                            withTiles ? &tiles : nullptr,
                            true,
-                           stream};
+                           stream,
+                           layout.stride};
         if (stream && withTiles && simdWidth() == 8) {
             EXPECT_TRUE(writesAround(g));
         }
@@ -95,10 +128,9 @@ struct Sums {
     }
     const BondFamilies& bonds;
     BondPairs pairs;
-    std::vector<int> pairOf;
+    Layout layout;
     std::vector<std::uint8_t> alive;
     PairSumTiles tiles;
-    unsigned slotMask;
     std::vector<double> slots;
 };
 
@@ -124,11 +156,16 @@ TEST_P(PairSums, HaveTheBitsOfOneParticleAtATime) {
     const int n = bonds.particleCount();
     const BondPairs pairs = buildBondPairs(bonds);
     for (const unsigned slotMask : {~0u, 63u}) {  // every pair its slot, or a ring of 64
-        const Sums tiled(bonds, tilePairs(bonds, pairs), slotMask);
+        const Sums tiled(bonds, ringOfPairs(tilePairs(bonds, pairs), slotMask));
         expectSameBits(tiled, 0, n);
-        expectSameBits(tiled, 3, n - 5);                // ranges that start and end inside a tile
-        const Sums csr(bonds, pairs.pairOf, slotMask);  // CSR pairs: few runs
+        expectSameBits(tiled, 3, n - 5);  // ranges that start and end inside a tile
+        const Sums csr(bonds, ringOfPairs(pairs.pairOf, slotMask));  // CSR pairs: few runs
         expectSameBits(csr, 0, n);
+    }
+    for (const int ringTiles : {4, 1 << 20}) {  // rows by k, wrapping often or never
+        const Sums byRow(bonds, ringOfRows(bonds, pairs, ringTiles));
+        expectSameBits(byRow, 0, n);
+        expectSameBits(byRow, 3, n - 5);
     }
 }
 
@@ -144,13 +181,13 @@ struct RowsOf25 {
     RowsOf25()
         : bonds(sheetBonds(0.24, 0.1, LatticeKind::Square, 1.5)),
           pairs(buildBondPairs(bonds)),
-          pairOf(tilePairs(bonds, pairs)),
-          tiles(PairSumTiles::build(bonds.offsets.data(), pairs.upperBegin.data(), pairOf.data(),
-                                    bonds.partners.data(), bonds.particleCount(), 63u)) {}
+          slot(ringOfPairs(tilePairs(bonds, pairs), 63u).slot),
+          tiles(PairSumTiles::build(bonds.offsets.data(), pairs.upperBegin.data(), slot.data(),
+                                    bonds.partners.data(), bonds.particleCount())) {}
     static constexpr int rowLength = 25;
     BondFamilies bonds;
     BondPairs pairs;
-    std::vector<int> pairOf;
+    std::vector<int> slot;
     PairSumTiles tiles;
 };
 

@@ -152,6 +152,7 @@ void PeridynamicBonds::setUpRowSlots() {
     bondSlot_.assign(bonds_.directedCount(), -1);
     for (std::size_t b = 0; b < bondSlot_.size(); ++b)
         if (const int u = slotOf_[b]; u >= 0) bondSlot_[b] = rowSlot_[u / kTile] + u % kTile;
+    std::vector<int>().swap(slotOf_);  // the pairs' numbers: not read in rows
     sumTiles_ = PairSumTiles::build(bonds_.offsets.data(), pairs_.upperBegin.data(),
                                     bondSlot_.data(), bonds_.partners.data(), n);
 }

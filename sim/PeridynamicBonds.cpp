@@ -117,7 +117,7 @@ void PeridynamicBonds::setUpPairArrays() {
 }
 
 // In rows: where each row's lane 0 lies in a thread's ring. On a sheet whose step fits the
-// caches, a ring of ringTiles_ tiles per row index k: the k-th rows of consecutive tiles lie side
+// caches, a ring of tiles per row index k: the k-th rows of consecutive tiles lie side
 // by side, so that the lower copies of a tile's particles (lanes of two tiles' rows: a lattice's
 // neighbours d particles back are lanes d % 8 on) load as one run where they were two and a
 // blend. Each k's ring is a line longer than its tiles, so that k's rows do not lie a multiple of

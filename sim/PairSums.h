@@ -25,6 +25,9 @@ struct PairSumTiles {
     struct Group {
         std::uint8_t firstLane, endLane, bonds, lower;  ///< bonds 0: one particle at a time
         int rowFirst;
+        /// Every row's lanes lie in one run (fromA all lanes), and half the bonds are lower
+        /// copies: a tile inside a regular lattice.
+        bool regular = false;
     };
     std::vector<Group> groups;
     /// A row (the k-th bonds of a group's lanes side by side): where lane 0's x would lie in

@@ -195,7 +195,9 @@ void BlowUpGuard::addWork(const State& state, const Sample& s) {
 void BlowUpGuard::check(const State& state, const std::function<double()>& totalEnergy) {
     const Sample s = sample(state);
     motionReady_ = false;
+    checkedSpeedSquared_ = -1.0;
     if (s.firstBad >= 0) report(state, s, "");
+    checkedSpeedSquared_ = s.maxSpeedSquared;
     if (!started_) {
         started_ = true;
         budget_ = floor_ + std::max(0.0, totalEnergy());

@@ -79,6 +79,9 @@ public:
     void check(const State& state, const std::function<double()>& totalEnergy);
 
     double budget() const { return budget_; }
+    /// The largest free particle's |v|^2 at the last check (over every process), or < 0 before
+    /// the first.
+    double checkedSpeedSquared() const { return checkedSpeedSquared_; }
 
     /// Sums of one pass over the particles (in fixed blocks, so any thread count gives the
     /// same bits).
@@ -127,6 +130,7 @@ private:
     double budget_ = 0.0;         ///< upper bound on the energy the run holds [J]
     bool started_ = false;
     double lastKinetic_ = 0.0;
+    double checkedSpeedSquared_ = -1.0;
     int growingSteps_ = 0;
     double growthProduct_ = 1.0;
     mutable std::vector<Sample> blocks_;

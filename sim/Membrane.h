@@ -47,7 +47,7 @@ public:
     /// reached by a cast).
     const Solver& solver() const { return *solver_; }
     /// This step's state as the solver sees it.
-    StepState stepState() const { return {x_, v_, theta_, dt_}; }
+    StepState stepState() const { return {x_, v_, theta_, dt_, 1.0, speedBound_}; }
     bool hasDiffusion() const { return diffusion_.has_value(); }
     const Diffusion* diffusion() const { return diffusion_ ? &*diffusion_ : nullptr; }
     std::size_t notchedBondCount() const { return notched_; }
@@ -143,6 +143,7 @@ public:
     }
     std::vector<Eigen::Vector3d>& velocities() {
         forcesCurrent_ = false;
+        speedBound_ = -1.0;
         return v_;
     }
     const std::vector<Eigen::Vector3d>& velocities() const { return v_; }
@@ -250,6 +251,9 @@ private:
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
     bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
+    /// At least every particle's |v| since the last check (StepState::speedBound), or -1 once v
+    /// may have changed: the guard's largest free speed, and the boundaries' speeds.
+    double speedBound_ = -1.0;
 };
 
 }  // namespace rend::sim

@@ -610,6 +610,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         // most rows have one (a sheet at rest, whose rounding compresses half its bonds by
         // 1e-16), the branch would miss too often.
         SpeedWindow speeds(in.v, n);
+        // Where the membrane knows a bound on every speed (the last check's), one slack for every
+        // block: |v| bounds each component, and v is not read again for it (crack_path_sources,
+        // power law: the windows' reads were 0.23 of 12.3 ns per particle-step).
+        const bool known = s.speedBound >= 0.0;
+        const double knownSlack = known ? lookAheadSlack(s.speedBound, s.dt) : 0.0;
         bool skipFar = false;
         int block = 0;
         const bool lookAhead = in.update && law_.kind == BondLawKind::PowerLaw;
@@ -621,7 +626,8 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             int near = 0;
             input.lookAheadSlack = in.lookAheadSlack, input.skipFar = in.skipFar;
             if (input.update && lookAhead && (skipFar || block++ % kProbe == 0)) {
-                input.lookAheadSlack = lookAheadSlack(speeds.over(p, q + reach_), s.dt);
+                input.lookAheadSlack =
+                    known ? knownSlack : lookAheadSlack(speeds.over(p, q + reach_), s.dt);
                 input.skipFar = true;
             }
             const int first = pairsBefore(p), end = pairsBefore(q);

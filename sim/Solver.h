@@ -41,6 +41,9 @@ struct StepState {
     /// stiffening() need be exact only above this (>= 1): a fixed step stays whole for any
     /// stiffening up to it, so a solver may report it for anything less (Membrane::piecesOfStep).
     double stiffeningNeeded = 1.0;
+    /// At least every particle's speed |v|, or < 0 where unknown (Membrane::speedBound): the
+    /// power law's look-ahead then bounds its pairs' rates from it instead of reading v.
+    double speedBound = -1.0;
 };
 
 /// What Membrane::failureApproachRate measures a step by (its constants).

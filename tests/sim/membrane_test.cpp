@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <utility>
 
 #include "tests/sim/Peridynamic.h"
 
@@ -285,7 +286,10 @@ TEST(Guard, WellBelowTheStableStepItBlamesTheForcesNotTheStep) {
     }
 }
 
-TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
+namespace {
+
+// A 0.4 m sheet pulled at 0.2 m/s (ramped over 0.01 s) on its right edge, pinned on its left.
+MembraneParams pulledAndPinned() {
     MembraneParams p = smallSheet(LatticeKind::Hexagonal, 0.4);
     BoundaryCondition pull, pin;
     pull.kind = BoundaryKind::Velocity;
@@ -296,6 +300,13 @@ TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
     pin.region.max.x() = -0.19;
     p.boundaries = {pull, pin};
     p.time.dt = 1e-4;
+    return p;
+}
+
+}  // namespace
+
+TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
+    const MembraneParams p = pulledAndPinned();
     Membrane m(p);
     const std::vector<int> counts = m.boundaryParticleCounts();
     EXPECT_GT(counts[0], 0);
@@ -307,6 +318,36 @@ TEST(Boundaries, VelocityRegionsFollowTheirRampAndPinnedRegionsStayPut) {
     for (int s = 0; s < 150; ++s) m.step();
     EXPECT_NEAR(m.velocities()[pulled].x(), 0.2, 1e-12);
     EXPECT_EQ(m.positions()[pinned], m.restPositions()[pinned]);
+}
+
+// The bound on every speed a step leaves for the next force pass (StepState::speedBound): the
+// largest free particle's |v| or the boundaries' full speed, whichever is larger; unknown
+// before the first step and again once the velocities may have changed (the writable
+// accessor, a checkpoint read back).
+TEST(Membrane, TheSpeedBoundCoversEveryParticleUntilTheVelocitiesChange) {
+    const MembraneParams p = pulledAndPinned();
+    for (const double kick : {0.0, 0.5}) {  // the boundary's speed is the largest, then a free one
+        Membrane m(p);
+        EXPECT_LT(m.stepState().speedBound, 0.0);
+        m.velocities()[m.nearestParticle({0.0, 0.0})] = {0.0, 0.0, kick};
+        for (int s = 0; s < 20; ++s) {
+            m.step();
+            double most = 0.0;
+            for (const Eigen::Vector3d& v : std::as_const(m).velocities())
+                most = std::max(most, v.norm());
+            const double bound = m.stepState().speedBound;
+            ASSERT_GE(bound, most) << "kick " << kick << ", step " << s;
+            EXPECT_NEAR(bound, std::max(most, 0.2), 1e-12 * bound) << "kick " << kick;
+        }
+        const std::vector<std::byte> saved = m.saveState();
+        m.step();
+        m.loadState(saved);
+        EXPECT_LT(m.stepState().speedBound, 0.0);
+        m.step();
+        EXPECT_GE(m.stepState().speedBound, 0.0);
+        m.velocities();
+        EXPECT_LT(m.stepState().speedBound, 0.0);
+    }
 }
 
 TEST(Lattice, DiscOutlineHoldsItsAreaWorthOfParticlesAllInside) {

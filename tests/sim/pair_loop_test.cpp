@@ -256,6 +256,18 @@ TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
                                               force.size() * sizeof(Eigen::Vector3d)),
                                   0);
                     }
+                    // With a bound on every speed given (StepState::speedBound, as the membrane
+                    // gives after a step) rather than read from v: the same largest and forces.
+                    double fastest = 0.0;
+                    for (const Eigen::Vector3d& u : v) fastest = std::max(fastest, u.norm());
+                    std::vector<Eigen::Vector3d> bounded;
+                    StepState s{x, v, {}, dt};
+                    s.speedBound = fastest;
+                    solver.advance(s, *solver.makeWorkspace(), bounded);
+                    EXPECT_EQ(solver.stiffening(), expected) << "speed bound " << fastest;
+                    EXPECT_EQ(std::memcmp(bounded.data(), force.data(),
+                                          force.size() * sizeof(Eigen::Vector3d)),
+                              0);
                 }
                 ASSERT_GT(stiffestBond, 0);
                 damage.breakBond(stiffestBond);

@@ -106,7 +106,8 @@ GuardInput guardInput(const BlowUpGuard::State& s, double limit, const Eigen::Ve
             theta && !s.theta.empty() ? s.theta.data() : nullptr,
             limit * limit,
             {gravity.x(), gravity.y(), gravity.z()},
-            hasGravity};
+            hasGravity,
+            s.oneMass};
 }
 
 BlowUpGuard::Sample sampleOf(const GuardSums& r) {

@@ -72,6 +72,7 @@ public:
         /// Decomposed (sim/Domain.h): this process samples its slab, and the sums are reduced
         /// over all of them, so every process decides alike.
         Domain* domain = nullptr;
+        double oneMass = 0.0;  ///< > 0: every particle's mass (sim/StepKernels.h's GuardInput)
     };
     /// Checks the state after a step; throws NumericalBlowUp naming the step, the fastest (or
     /// first non-finite) particle and a suggested dt. `totalEnergy` (kinetic + strain) is

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -31,6 +32,10 @@ Membrane::Membrane(const MembraneParams& given)
     const std::vector<double> density =
         materialFactors(MappedProperty::Density, params.materialMaps, x0_);
     for (int i = 0; i < n; ++i) mass_[i] = params.material.density * density[i] * volume_[i];
+    const bool one = std::all_of(mass_.begin(), mass_.end(), [&](double m) {
+        return std::bit_cast<std::uint64_t>(m) == std::bit_cast<std::uint64_t>(mass_[0]);
+    });
+    oneMass_ = one && mass_[0] > 0.0 && std::isfinite(mass_[0]) ? mass_[0] : 0.0;
     bonds_ = buildBondFamilies(x0_, horizon_);
     damageState_ = DamageState(bonds_, lattice_.triangles);
     const Material material(params.material);  // validated once, for every solver
@@ -176,9 +181,11 @@ void Membrane::kick(double h, double tNext) {
 }
 
 void Membrane::checkFinite() {
-    guard_.check({x_, v_, force_, x0_, mass_, theta_, constraint_, steps_, time_, dt_, stableDt_,
-                  adaptiveStep_, colliderWork(), domain_},
-                 [this] { return totalEnergy(); });
+    BlowUpGuard::State state{
+        x_,     v_,    force_, x0_,       mass_,         theta_,         constraint_,
+        steps_, time_, dt_,    stableDt_, adaptiveStep_, colliderWork(), domain_};
+    state.oneMass = oneMass_;
+    guard_.check(state, [this] { return totalEnergy(); });
     // The check read every free particle's v (over every process), the pinned are at rest and
     // the driven at most at their boundary's full speed: a bound on every speed until v next
     // changes, so that the next force pass need not read v for it.
@@ -235,13 +242,15 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
                 dt,
                 {},
                 params_.damping};
+    k.oneMass = oneMass_;
     for (int a = 0; a < 3; ++a) k.gravity[a] = params_.gravity[a];
     const double floor = contact_ ? contact_->groundOnlyFloor() : Contact::kNoFloor;
     k.floor = floor;
     // The guard's blocks: each is sampled for the step's check right after it moved, in cache.
     constexpr int kBlock = BlowUpGuard::kBlock;
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
-    const BlowUpGuard::State moved{{}, v_, force_, {}, mass_, {}, constraint_};
+    BlowUpGuard::State moved{{}, v_, force_, {}, mass_, {}, constraint_};
+    moved.oneMass = oneMass_;
     guard_.beginMotion(begin_, end_);
     bool below = false;
 #pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold) \

@@ -158,6 +158,9 @@ public:
     const std::vector<Eigen::Vector3d>& positions() const { return x_; }
     const std::vector<Eigen::Vector3d>& restPositions() const { return x0_; }
     const std::vector<double>& masses() const { return mass_; }
+    /// Every particle's mass where they are all the same to the bit (a sheet without a density
+    /// map whose particles have one area), else 0: the kick and the guard then read no masses.
+    double oneMass() const { return oneMass_; }
     const std::vector<double>& volumes() const { return volume_; }
     BondFamilies& bonds() { return bonds_; }
     const BondFamilies& bonds() const { return bonds_; }
@@ -247,6 +250,7 @@ private:
     // Structure of arrays: one contiguous array per attribute.
     std::vector<Eigen::Vector3d> x_, v_, x0_, force_;
     std::vector<double> mass_, volume_;
+    double oneMass_ = 0.0;                  ///< oneMass()
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_

@@ -16,14 +16,20 @@ namespace {
 
 constexpr std::int16_t kFree = -1;
 
+/// Particle i's mass: the one mass where the sheet has one.
+template <class Input>
+inline double massOf(const Input& in, int i) {
+    return in.oneMass > 0.0 ? in.oneMass : in.mass[i];
+}
+
 /// One particle; returns whether it is free and not above the floor (NaN included).
 inline bool kickDriftOne(const KickDrift& k, int i) {
     double* v = k.v + 3 * i;
     const std::int16_t c = k.constraint[i];
     if (c == kFree) {
         const double* f = k.force + 3 * i;
-        for (int a = 0; a < 3; ++a)
-            v[a] += k.h * (f[a] / k.mass[i] + k.gravity[a] - k.damping * v[a]);
+        const double mass = massOf(k, i);
+        for (int a = 0; a < 3; ++a) v[a] += k.h * (f[a] / mass + k.gravity[a] - k.damping * v[a]);
     } else {
         for (int a = 0; a < 3; ++a) v[a] = c < 0 ? 0.0 : k.boundaryVelocity[3 * c + a];
     }
@@ -57,10 +63,10 @@ inline void guardVisit(const GuardInput& g, int i, GuardPart& p, GuardSums& s) {
         if (c >= 0) p.boundaryPower += std::abs((f[0] * v[0] + f[1] * v[1]) + f[2] * v[2]);
         return;
     }
-    p.kinetic += 0.5 * g.mass[i] * speedSquared;
+    const double mass = massOf(g, i);
+    p.kinetic += 0.5 * mass * speedSquared;
     const double* a = g.gravity;
-    if (g.hasGravity)
-        p.gravityPower += g.mass[i] * std::abs((a[0] * v[0] + a[1] * v[1]) + a[2] * v[2]);
+    if (g.hasGravity) p.gravityPower += mass * std::abs((a[0] * v[0] + a[1] * v[1]) + a[2] * v[2]);
     if (speedSquared > s.maxSpeedSquared) s.maxSpeedSquared = speedSquared, s.fastest = i;
 }
 
@@ -110,7 +116,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             for (int p = i; p < i + 4; ++p) below |= kickDriftOne(k, p);
             continue;
         }
-        const double* m = k.mass + i;
+        const double m[4] = {massOf(k, i), massOf(k, i + 1), massOf(k, i + 2), massOf(k, i + 3)};
         const __m256d mass[3] = {_mm256_setr_pd(m[0], m[0], m[0], m[1]),
                                  _mm256_setr_pd(m[1], m[1], m[2], m[2]),
                                  _mm256_setr_pd(m[2], m[3], m[3], m[3])};
@@ -148,17 +154,21 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
                              _mm512_setr_epi64(2, 0, 1, 2, 0, 1, 2, 0),
                              _mm512_setr_epi64(1, 2, 0, 1, 2, 0, 1, 2)};
     constexpr __mmask8 kZLanes[3] = {0b00100100, 0b01001001, 0b10010010};
+    // One mass for the sheet: its 8 bytes a particle not streamed (10^6 particles, interleaved:
+    // crack_path_sources, linear law, 13.86 -> 13.51 ns, power law 15.68 -> 15.32).
+    const bool one = k.oneMass > 0.0;
+    const __m512d oneMass = _mm512_set1_pd(k.oneMass);
     int i = begin;
     for (; i + 8 <= end; i += 8) {
         if (!allFree(k.constraint + i, 8)) {
             for (int p = i; p < i + 8; ++p) below |= kickDriftOne(k, p);
             continue;
         }
-        const __m512d masses = _mm512_loadu_pd(k.mass + i);
+        const __m512d masses = one ? oneMass : _mm512_loadu_pd(k.mass + i);
         for (int lane = 0; lane < 3; ++lane) {
             double* v = k.v + 3 * i + 8 * lane;
             double* x = k.x + 3 * i + 8 * lane;
-            const __m512d mass = _mm512_permutexvar_pd(particle[lane], masses);
+            const __m512d mass = one ? oneMass : _mm512_permutexvar_pd(particle[lane], masses);
             const __m512d gravity = _mm512_permutexvar_pd(axis[lane], g);
             const __m512d f = _mm512_loadu_pd(k.force + 3 * i + 8 * lane);
             __m512d vel = _mm512_loadu_pd(v);
@@ -194,6 +204,8 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     __m512d kinetic = _mm512_setzero_pd(), gravityPower = _mm512_setzero_pd();
     __m512d best = _mm512_setzero_pd();
     __m512i bestAt = _mm512_set1_epi64(-1);
+    const bool one = g.oneMass > 0.0;
+    const __m512d oneMass = _mm512_set1_pd(g.oneMass);
     int i = begin;
     for (; i + 8 <= end; i += 8) {
         if (!allFree(g.constraint + i, 8)) {
@@ -206,7 +218,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             _mm512_add_pd(_mm512_mul_pd(vx, vx), _mm512_mul_pd(vy, vy)), _mm512_mul_pd(vz, vz));
         const unsigned bad = _mm512_cmp_pd_mask(ss, limit, _CMP_NLE_UQ);
         if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(bad);
-        const __m512d m = _mm512_loadu_pd(g.mass + i);
+        const __m512d m = one ? oneMass : _mm512_loadu_pd(g.mass + i);
         kinetic = _mm512_add_pd(kinetic, _mm512_mul_pd(_mm512_mul_pd(half, m), ss));
         if (g.hasGravity) {
             const __m512d along = _mm512_add_pd(

@@ -25,6 +25,9 @@ struct KickDrift {
     double gravity[3] = {0.0, 0.0, 0.0};
     double damping = 0.0;
     double floor = -std::numeric_limits<double>::infinity();  ///< the ground's height; -inf: none
+    /// Where every particle has the same mass (Membrane::oneMass()), that mass, and `mass` is
+    /// not read (a sheet past the caches streams 8 bytes a particle less); 0: per particle.
+    double oneMass = 0.0;
 };
 
 /// Particles [begin, end): v += h (f / m + g - damping v) for the free ones, the pinned at rest,
@@ -42,6 +45,7 @@ struct GuardInput {
     double limitSquared = 0.0;      ///< the speed limit, squared
     double gravity[3] = {0.0, 0.0, 0.0};
     bool hasGravity = false;
+    double oneMass = 0.0;  ///< as KickDrift's: > 0, every particle's mass (`mass` not read)
 };
 
 /// Its sums (BlowUpGuard::Sample's): in a fixed order for a given range and width, so the same

@@ -239,6 +239,30 @@ TEST(MaterialMap, AToughSideHoldsWhereThePlainSideBreaks) {
     EXPECT_EQ(right, 0);
 }
 
+// The kick and the guard take one mass for the sheet only where every particle has it to the
+// bit (Membrane::oneMass): a density map, or particles of different areas, read their own.
+TEST(MaterialMap, OneMassOnlyWhereEveryParticleHasIt) {
+    const auto oneMassHolds = [](const Membrane& m) {
+        const std::vector<double>& mass = m.masses();
+        const bool same = std::all_of(mass.begin(), mass.end(),
+                                      [&](double value) { return value == mass.front(); });
+        return m.oneMass() == (same ? mass.front() : 0.0);
+    };
+    MembraneParams square = sheet();
+    square.sheet.lattice = LatticeKind::Square;
+    const Membrane plain(square), hexagonal(sheet());
+    EXPECT_GT(plain.oneMass(), 0.0) << "a square sheet's particles all have one area";
+    EXPECT_TRUE(oneMassHolds(plain));
+    EXPECT_TRUE(oneMassHolds(hexagonal));
+    MaterialMap heavy = region(MapShape::Box, 4.0);
+    heavy.property = MappedProperty::Density;
+    heavy.min = {0.0, -1.0}, heavy.max = {1.0, 1.0};
+    square.materialMaps = {heavy};
+    const Membrane dense(square);
+    EXPECT_EQ(dense.oneMass(), 0.0) << "half the sheet four times as heavy";
+    EXPECT_TRUE(oneMassHolds(dense));
+}
+
 // The density is the diffusion's too: four times the density is four times the thermal mass
 // rho C, so theta spreads four times slower and its explicit step may be four times longer.
 TEST(MaterialMap, ADensityMapIsTheDiffusionsThermalMassToo) {

@@ -85,6 +85,26 @@ TEST(KickDrift, GivesTheBitsOfTheEigenStepForEveryConstraint) {
     }
 }
 
+// With one mass for the sheet (KickDrift::oneMass) the mass array is not read: the same bits as
+// every particle's own mass of that value, at every width and in every block.
+TEST(KickDrift, OneMassGivesTheBitsOfEveryParticleHavingIt) {
+    Particles start = someParticles(203);
+    const double mass = 3.7e-4;
+    start.mass.assign(start.mass.size(), mass);
+    const std::vector<double> boundary = {0.5, 0.0, -0.25, 0.0, 1e-3, 2.0};
+    Particles each = start, one = start;
+    KickDrift k = viewOf(each, boundary, 1.3e-4, 1.1e-4);
+    k.damping = 0.7, k.gravity[2] = -9.81;
+    kickDrift(k, 0, int(each.x.size()));
+    std::vector<double> wrong(one.mass.size(), 2.0 * mass);  // read, they would show
+    KickDrift o = viewOf(one, boundary, 1.3e-4, 1.1e-4);
+    o.damping = 0.7, o.gravity[2] = -9.81, o.mass = wrong.data(), o.oneMass = mass;
+    kickDrift(o, 0, 101), kickDrift(o, 101, int(one.x.size()));
+    EXPECT_TRUE(sameBits(one.v, each.v));
+    EXPECT_TRUE(sameBits(one.x, each.x));
+    EXPECT_FALSE(sameBits(one.v, start.v)) << "the kick moved them";
+}
+
 // The floor test counts exactly the free particles whose new z is not >= the floor, whichever
 // block of four or eight they sit in; pinned and driven ones never count, and NaN does.
 TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {
@@ -169,6 +189,34 @@ TEST(GuardSums, MatchTheSumsOneParticleAtATime) {
             EXPECT_NEAR(got.gravityPower, want.gravityPower, 1e-14 * want.gravityPower);
             EXPECT_NEAR(got.boundaryPower, want.boundaryPower, 1e-14 * want.boundaryPower);
         }
+    }
+}
+
+// GuardInput::oneMass: the sums of every particle having that mass, to the bit, the mass array
+// unread.
+TEST(GuardSums, OneMassGivesTheSumsOfEveryParticleHavingIt) {
+    for (const int n : {5, 64, 203}) {
+        Particles p = someParticles(n);
+        const double mass = 2.9e-4;
+        p.mass.assign(n, mass);
+        GuardInput each{p.v.data()->data(),
+                        p.force.data()->data(),
+                        p.mass.data(),
+                        p.constraint.data(),
+                        nullptr,
+                        30.0,
+                        {0.0, 0.0, -9.81},
+                        true};
+        const std::vector<double> wrong(n, 5.0 * mass);
+        GuardInput one = each;
+        one.mass = wrong.data(), one.oneMass = mass;
+        const GuardSums a = guardSums(each, 0, n), b = guardSums(one, 0, n);
+        EXPECT_GT(a.kinetic, 0.0);
+        EXPECT_EQ(b.kinetic, a.kinetic) << n;
+        EXPECT_EQ(b.gravityPower, a.gravityPower) << n;
+        EXPECT_EQ(b.boundaryPower, a.boundaryPower) << n;
+        EXPECT_EQ(b.maxSpeedSquared, a.maxSpeedSquared) << n;
+        EXPECT_EQ(b.fastest, a.fastest) << n;
     }
 }
 

@@ -116,39 +116,33 @@ void PeridynamicBonds::setUpPairArrays() {
     if (slotRows()) setUpRowSlots();
 }
 
-// In rows: where each row's lane 0 lies in a thread's ring. On a sheet whose step fits the
-// caches, a ring of tiles per row index k: the k-th rows of consecutive tiles lie side
-// by side, so that the lower copies of a tile's particles (lanes of two tiles' rows: a lattice's
-// neighbours d particles back are lanes d % 8 on) load as one run where they were two and a
-// blend. Each k's ring is a line longer than its tiles, so that k's rows do not lie a multiple of
-// 4 KiB apart (interleaved, crack_path_sources, 10^4 particles: linear 10.66 -> 10.49 ns,
-// elastoplastic 12.37 -> 12.11). On a sheet that streams from memory the rows stay in pair
-// order, placed by slotAt() without the table: by k, or by the table alone, 10^6 particles
-// took 13.0 -> 13.3.
+// In rows: where each row's lane 0 lies in a thread's ring: a ring of tiles per row index k, the
+// k-th rows of consecutive tiles side by side, so that the lower copies of a tile's particles
+// (lanes of two tiles' rows: a lattice's neighbours d particles back are lanes d % 8 on) load as
+// one run where they were two and a blend, and a lattice's tiles are regular (sim/PairSums.h).
+// Each k's ring is a line longer than its tiles, so that k's rows do not lie a multiple of 4 KiB
+// apart (interleaved, crack_path_sources, 10^4 particles: linear 10.66 -> 10.49 ns,
+// elastoplastic 12.37 -> 12.11). A sheet that streams from memory kept the rows in pair order
+// while that was faster (10^6 particles: 13.0 against 13.3 by k); since the regular tiles' sums
+// are straight code, by k is faster there too (crack_path_sources at 10^6, interleaved, best of
+// three: linear 13.71 -> 13.20, power law 15.57 -> 14.90, elastoplastic 14.91 -> 14.43).
 void PeridynamicBonds::setUpRowSlots() {
     const int n = bonds_.particleCount(), tiles = int(tileBegin_.size()) - 1;
     rowSlot_.assign(pairFirst_.size() / kTile, 0);
-    rowsByK_ = !streamsForces(n);
-    if (!rowsByK_) {  // pair u's x at slotAt(u & (ringPairs_ - 1)), as the kernels place it
-        rowStride_ = kPairTile, ringDoubles_ = 2 * kPairTile + 3 * ringPairs_;
-        for (std::size_t r = 0; r < rowSlot_.size(); ++r)
-            rowSlot_[r] = kSlotRow * int(r & std::size_t(ringPairs_ / kTile - 1));
-    } else {
-        int windowTiles = 1, rowsPerTile = 1;
-        for (int p = 0; p < n; p += kTile)
-            windowTiles = std::max(windowTiles, (std::min(n, p + kFusedBlock) + kTile - 1) / kTile -
-                                                    tileStart(std::max(0, p - reach_)) / kTile);
-        for (int t = 0; t < tiles; ++t)
-            rowsPerTile = std::max(rowsPerTile, (tileBegin_[t + 1] - tileBegin_[t]) / kTile);
-        int ringTiles = 1;
-        while (ringTiles < windowTiles) ringTiles *= 2;
-        const int ringOfK = kTile * (ringTiles + 1);
-        rowStride_ = rowsPerTile * ringOfK + kPairTile;  // x, then y, then z
-        ringDoubles_ = kPairTile + 3 * rowStride_;
-        for (int t = 0; t < tiles; ++t)
-            for (int k = 0; k < (tileBegin_[t + 1] - tileBegin_[t]) / kTile; ++k)
-                rowSlot_[tileBegin_[t] / kTile + k] = k * ringOfK + kTile * (t & (ringTiles - 1));
-    }
+    int windowTiles = 1, rowsPerTile = 1;
+    for (int p = 0; p < n; p += kTile)
+        windowTiles = std::max(windowTiles, (std::min(n, p + kFusedBlock) + kTile - 1) / kTile -
+                                                tileStart(std::max(0, p - reach_)) / kTile);
+    for (int t = 0; t < tiles; ++t)
+        rowsPerTile = std::max(rowsPerTile, (tileBegin_[t + 1] - tileBegin_[t]) / kTile);
+    int ringTiles = 1;
+    while (ringTiles < windowTiles) ringTiles *= 2;
+    const int ringOfK = kTile * (ringTiles + 1);
+    rowStride_ = rowsPerTile * ringOfK + kPairTile;  // x, then y, then z
+    ringDoubles_ = kPairTile + 3 * rowStride_;
+    for (int t = 0; t < tiles; ++t)
+        for (int k = 0; k < (tileBegin_[t + 1] - tileBegin_[t]) / kTile; ++k)
+            rowSlot_[tileBegin_[t] / kTile + k] = k * ringOfK + kTile * (t & (ringTiles - 1));
     bondSlot_.assign(bonds_.directedCount(), -1);
     for (std::size_t b = 0; b < bondSlot_.size(); ++b)
         if (const int u = slotOf_[b]; u >= 0) bondSlot_[b] = rowSlot_[u / kTile] + u % kTile;
@@ -636,7 +630,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                 const int stop = std::min(end, base + ringPairs_);
                 input.stiffestKnown = most;
                 LinearPairOutput out{ring, work.over.data(), base, rows};
-                if (rows && rowsByK_) out.rowSlot = rowSlot_.data(), out.stride = rowStride_;
+                if (rows) out.rowSlot = rowSlot_.data(), out.stride = rowStride_;
                 out.nearRows = &near;
                 most = std::max(most, linearPairForces(input, out, u, stop));
                 u = stop;

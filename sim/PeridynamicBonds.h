@@ -173,7 +173,6 @@ private:
     /// where each row's lane 0 lies (per row of pairs) and each directed bond's pair (per bond;
     /// -1: none).
     int rowStride_ = kTile, ringDoubles_ = 0;
-    bool rowsByK_ = false;  ///< rowSlot_ by row index k; else in pair order (slotAt())
     std::vector<int> rowSlot_, bondSlot_;
     void setUpRowSlots();
     std::span<const Eigen::Vector3d> rest_;

@@ -47,6 +47,8 @@ public:
                  std::uint64_t aliveVersion, double t, double dt);
 
     std::size_t spotCount() const { return spots_.size(); }
+    /// The bonds' rates in tiles (sim/DiffusionKernels.h).
+    const DiffusionTiles& tiles() const { return tiles_; }
 
     /// Decomposed runs (sim/Domain.h): advances only its slab's theta, and refreshes the
     /// ghosts through `domain` after every sub-step.
@@ -73,7 +75,8 @@ private:
     double stableDt_ = 0.0;
     double initial_ = 0.0;
     int particles_ = 0;
-    /// Per bond, K W0 V_j / (rho C |xi|^2) [1/s], in tiles of eight particles.
+    /// Per bond, K W0 V_j / (rho C |xi|^2) [1/s], in tiles of eight particles; a lattice's bond
+    /// at its exact length (sim/Diffusion.cpp's LatticeLength).
     DiffusionTiles tiles_;
     std::vector<Spot> spots_;
     std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <tuple>
@@ -150,3 +152,74 @@ TEST(DiffusionTiles, FollowTheBondsAsTheyBreak) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Sheet's bonds rebuilt with its particles moved: far from the origin (their coordinates'
+/// rounding spreads a direction's rest lengths over many last bits), or off the lattice.
+void moveParticles(Sheet& sheet, bool far, bool jitter) {
+    for (std::size_t i = 0; i < sheet.lattice.positions.size(); ++i) {
+        Eigen::Vector3d& x = sheet.lattice.positions[i];
+        if (far) x += Eigen::Vector3d(40.3, -23.7, 0.0);
+        if (jitter)
+            x += 1e-3 * sheet.params.sheet.dx *
+                 Eigen::Vector3d(uniformFromHash(3, 2 * i), uniformFromHash(3, 2 * i + 1), 0.0);
+    }
+    sheet.bonds = buildBondFamilies(sheet.lattice.positions,
+                                    sheet.params.sheet.horizonFactor * sheet.params.sheet.dx);
+}
+
+/// Eq. 25's rate of directed bond b at length xi (sim/Diffusion.h).
+double rateAt(const Diffusion& d, const Sheet& sheet, int b, double xi, double weight) {
+    const MaterialParams& m = sheet.params.material;
+    return d.coefficient() * weight * sheet.volumes[sheet.bonds.partners[b]] /
+           (m.density * m.capacity * xi * xi);
+}
+
+}  // namespace
+
+// A lattice's bonds take eq. 25's rate at their exact length dx sqrt(k): far from the origin,
+// where the rest lengths of one direction differ in their last bits, every row of rates is still
+// one value (no steps to stream), and the rates are the lattice's to the bit.
+TEST(DiffusionRates, ALatticeTakesItsExactLengths) {
+    for (const LatticeKind kind : {LatticeKind::Square, LatticeKind::Hexagonal}) {
+        Sheet sheet(kind);
+        moveParticles(sheet, true, false);
+        const Diffusion diffusion(sheet.params, sheet.lattice.positions, sheet.bonds,
+                                  sheet.volumes);
+        const DiffusionTiles& tiles = diffusion.tiles();
+        const int rows = int(tiles.rowClass.size());
+        const auto stepped = std::count_if(tiles.rowClass.begin(), tiles.rowClass.end(),
+                                           [](int c) { return c <= DiffusionTiles::kSteppedRate; });
+        EXPECT_EQ(stepped, 0) << "of " << rows << " rows";
+        const Sheet home(kind);  // at the origin: the rows that mix directions are per bond
+        const Diffusion atHome(home.params, home.lattice.positions, home.bonds, home.volumes);
+        EXPECT_EQ(tiles.classedRows(), atHome.tiles().classedRows());
+        EXPECT_GT(tiles.classedRows(), rows * 9 / 10);
+        const double dx = sheet.params.sheet.dx;
+        const double horizon = sheet.params.sheet.horizonFactor * dx;
+        int checked = 0;
+        for (std::size_t u = 0; u < tiles.bond.size(); ++u) {
+            const int b = tiles.bond[u];
+            if (b < 0) continue;
+            const double k = std::round(std::pow(sheet.bonds.restLength[b] / dx, 2));
+            const double xi = dx * std::sqrt(k);
+            ASSERT_EQ(tiles.rate[u], rateAt(diffusion, sheet, b, xi, 1.0 - xi / horizon)) << u;
+            checked += sheet.bonds.restLength[b] != xi;
+        }
+        EXPECT_GT(checked, 100) << "rest lengths off their lattice's by rounding";
+    }
+}
+
+// Off a lattice, each bond keeps the rate of its own rest length and W0.
+TEST(DiffusionRates, OffALatticeEachBondKeepsItsOwnLength) {
+    Sheet sheet(LatticeKind::Square);
+    moveParticles(sheet, false, true);
+    const Diffusion diffusion(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    const DiffusionTiles& tiles = diffusion.tiles();
+    for (std::size_t u = 0; u < tiles.bond.size(); ++u)
+        if (const int b = tiles.bond[u]; b >= 0)
+            ASSERT_EQ(tiles.rate[u],
+                      rateAt(diffusion, sheet, b, sheet.bonds.restLength[b], sheet.bonds.weight[b]))
+                << u;
+}

@@ -63,7 +63,7 @@ struct Case {
     /// direction rest lengths a few hundred last bits apart (rows of a class plus steps).
     bool far = false;
     /// A sheet of 4 x 4 m: 160,801 particles, whose step streams from memory
-    /// (streamsForces()): its pair rows lie in pair order rather than by row index.
+    /// (streamsForces()): the tile sums' stores go around the caches.
     bool huge = false;
 };
 

@@ -7,7 +7,9 @@
 // per bond law (linear, power_law, elastoplastic), ns per particle-step on 1 thread of the same
 // sheet, and of crack_path_sources (its notch breaking, two heat sources diffusing: theta and
 // breaking on), both square at dt 1e-4; with --largest 1e6 or more, crack_path_sources too on a
-// sheet 20 m square at its spacing (1,002,001 particles, 20 steps in).
+// sheet 20 m square at its spacing (1,002,001 particles, 20 steps in). The linear and
+// elastoplastic laws again with the kick and drift in their own pass after the forces
+// (Membrane::setKickInPass(false), the order before issue 16's last round): its cost beside.
 //
 //   build/bench_speed [--largest N]   (default 10000000; sizes 1e4, 1e5, 1e6, 1e7 up to it)
 //   REND_SIMD=avx2 build/bench_speed  (the four-lane kernels on a CPU with AVX-512)
@@ -145,7 +147,8 @@ constexpr const char* kLaws[] = {"linear", "power_law", "elastoplastic"};
 
 /// ns per particle-step on 1 thread of `scene` with [material] law = `law`, after `warm` steps;
 /// with `side` > 0, on a sheet `side` metres square at the scene's spacing.
-double lawRow(const std::string& scene, const char* law, double side = 0.0, int warm = 200) {
+double lawRow(const std::string& scene, const char* law, double side = 0.0, int warm = 200,
+              bool kickInPass = true) {
     std::vector<std::string> sets = {"sheet.lattice=\"square\"", "time.dt=1e-4",
                                      std::string("material.law=\"") + law + "\""};
     if (side > 0.0) {
@@ -155,6 +158,7 @@ double lawRow(const std::string& scene, const char* law, double side = 0.0, int 
     }
     const rend::Scene s = rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/" + scene, sets);
     rend::sim::Membrane membrane(s.sim);
+    membrane.setKickInPass(kickInPass);
     omp_set_num_threads(1);
     for (int k = 0; k < warm; ++k) membrane.step();
     return nsPerParticleStep(membrane, 1, 2.0);
@@ -184,6 +188,11 @@ int main(int argc, char** argv) {
     for (const char* law : kLaws)
         laws.push_back({lawRow("stretch.toml", law), lawRow("crack_path_sources.toml", law),
                         large ? lawRow("crack_path_sources.toml", law, 20.0, 20) : 0.0});
+    for (const int k : {0, 2})  // the kick in its own pass
+        laws.push_back(
+            {lawRow("stretch.toml", kLaws[k], 0.0, 200, false),
+             lawRow("crack_path_sources.toml", kLaws[k], 0.0, 200, false),
+             large ? lawRow("crack_path_sources.toml", kLaws[k], 20.0, 20, false) : 0.0});
     double rendAt1e4 = 0.0;
     for (const int side : {101, 317, 1001, 3163}) {
         if (side > 101 && long(side) * side > largest * 1.01) break;  // 10^4 always runs
@@ -204,10 +213,12 @@ int main(int argc, char** argv) {
             lammps, rendAt1e4, lammps / rendAt1e4);
     }
     std::printf("\nns per particle-step, 1 thread, square lattice, dt 1e-4, per bond law\n");
-    std::printf("%-16s %18s %36s %26s\n", "law", "stretch (10,201)",
+    std::printf("%-30s %18s %36s %26s\n", "law", "stretch (10,201)",
                 "crack_path_sources (theta, breaking)", "the same at 1,002,001");
+    const char* names[] = {kLaws[0], kLaws[1], kLaws[2], "linear, kick in own pass",
+                           "elastoplastic, kick in own pass"};
     for (std::size_t k = 0; k < laws.size(); ++k) {
-        std::printf("%-16s %18.1f %36.1f", kLaws[k], laws[k][0], laws[k][1]);
+        std::printf("%-30s %18.1f %36.1f", names[k], laws[k][0], laws[k][1]);
         if (large) std::printf(" %26.1f", laws[k][2]);
         std::printf("\n");
     }

@@ -4,10 +4,12 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "sim/Fracture.h"
 #include "sim/Material.h"
@@ -202,14 +204,16 @@ void Membrane::checkFinite() {
 // the adaptive step changes it thousands of times, and at half the bound that heated the lattice
 // until a brittle sheet shattered (seaweed at 46K particles: 103,185 bonds broken against 1,324
 // at a constant step). At a constant step the kick is h exactly, bit for bit.
-void Membrane::integrate(double dt, double tNext) {
-    const double kickDt = lastDrift_ > 0.0 ? 0.5 * (lastDrift_ + dt) : dt;
+void Membrane::integrate(double dt, double tNext, std::optional<bool> moved) {
+    const double kickDt = kickBefore(dt);
     lastDrift_ = dt;
     speedBound_ = -1.0;
     const int n = particleCount();
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
-    if (solver_->carriesMomentum()) {  // MPM: the kick, the grid, then the drift
+    if (moved) {  // the force pass kicked and drifted them (stepSymplecticEuler)
+        collide(tNext, *moved);
+    } else if (solver_->carriesMomentum()) {  // MPM: the kick, the grid, then the drift
 #pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
         for (int i = 0; i < n; ++i) updateVelocity(i, kickDt, tNext, gravity, damping);
         if (contact_ && contact_->hasColliders()) contact_->place(tNext - dt);
@@ -226,8 +230,9 @@ void Membrane::integrate(double dt, double tNext) {
 // updateVelocity and the drift in one pass (sim/StepKernels.h: the same bits), by blocks.
 // Returns whether a free particle may touch the ground where the ground is the only collider
 // (true wherever there are other colliders or none of this kind).
-bool Membrane::kickAndDrift(double h, double dt, double tNext) {
-    std::vector<double> prescribed(3 * params_.boundaries.size());
+KickDrift Membrane::kickDriftOf(double h, double dt, double tNext,
+                                std::vector<double>& prescribed) {
+    prescribed.assign(3 * params_.boundaries.size(), 0.0);
     for (std::size_t b = 0; b < params_.boundaries.size(); ++b) {
         const Eigen::Vector3d velocity = boundaryVelocity(int(b), tNext);
         for (int a = 0; a < 3; ++a) prescribed[3 * b + a] = velocity[a];
@@ -244,13 +249,24 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
                 params_.damping};
     k.oneMass = oneMass_;
     for (int a = 0; a < 3; ++a) k.gravity[a] = params_.gravity[a];
-    const double floor = contact_ ? contact_->groundOnlyFloor() : Contact::kNoFloor;
-    k.floor = floor;
+    k.floor = contact_ ? contact_->groundOnlyFloor() : Contact::kNoFloor;
+    return k;
+}
+
+BlowUpGuard::State Membrane::motionState() const {
+    BlowUpGuard::State moved{{}, v_, force_, {}, mass_, {}, constraint_};
+    moved.oneMass = oneMass_;
+    return moved;
+}
+
+bool Membrane::kickAndDrift(double h, double dt, double tNext) {
+    std::vector<double> prescribed;
+    const KickDrift k = kickDriftOf(h, dt, tNext, prescribed);
+    const double floor = k.floor;
     // The guard's blocks: each is sampled for the step's check right after it moved, in cache.
     constexpr int kBlock = BlowUpGuard::kBlock;
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
-    BlowUpGuard::State moved{{}, v_, force_, {}, mass_, {}, constraint_};
-    moved.oneMass = oneMass_;
+    const BlowUpGuard::State moved = motionState();
     guard_.beginMotion(begin_, end_);
     bool below = false;
 #pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold) \
@@ -283,9 +299,10 @@ double Membrane::contactStepLimit() const {
                                               : std::numeric_limits<double>::infinity();
 }
 
-void Membrane::accumulateForces() {
+void Membrane::accumulateForces(BlockMotion* motion) {
     StepState s = stepState();
     s.stiffeningNeeded = stiffeningNeeded();
+    s.motion = motion;
     solver_->advance(s, *workspace_, force_);
     stiffening_ = domain_ ? domain_->max(solver_->stiffening()) : solver_->stiffening();
     if (params_.pressure != 0.0) addPressure(force_);
@@ -345,9 +362,77 @@ double Membrane::stiffeningNeeded() const {
     return std::isfinite(whole) && whole > 1.0 && stiffeningPieces(whole) <= 1.0 ? whole : 1.0;
 }
 
+namespace {
+
+// Membrane's kick and drift of each block the solver's pass hands over (StepState::motion), and
+// the blow-up guard's sample of each of the guard's blocks once all of it has moved, by the
+// thread that moved its last particles: the separate pass's kernels and sums over the same
+// blocks, so the same bits.
+class KickInPass final : public BlockMotion {
+public:
+    KickInPass(const KickDrift& kick, BlowUpGuard& guard, const BlowUpGuard::State& state,
+               int first, int last)
+        : kick_(kick), guard_(guard), state_(state), first_(first) {
+        constexpr int kBlock = BlowUpGuard::kBlock;
+        const int blocks = (last - first + kBlock - 1) / kBlock;
+        left_ = std::make_unique<std::atomic<int>[]>(std::size_t(blocks));
+        for (int b = 0; b < blocks; ++b)
+            left_[b].store(std::min(last, first + (b + 1) * kBlock) - (first + b * kBlock));
+        guard_.beginMotion(first, last);
+    }
+    void move(int begin, int end) override {
+        if (kickDrift(kick_, begin, end)) below_.store(true, std::memory_order_relaxed);
+        moved_.fetch_add(end - begin, std::memory_order_relaxed);
+        constexpr int kBlock = BlowUpGuard::kBlock;
+        for (int b = (begin - first_) / kBlock; first_ + b * kBlock < end; ++b) {
+            const int part =
+                std::min(end, first_ + (b + 1) * kBlock) - std::max(begin, first_ + b * kBlock);
+            if (left_[b].fetch_sub(part, std::memory_order_acq_rel) == part)
+                guard_.sampleMotion(state_, b);
+        }
+    }
+    int moved() const { return moved_.load(); }
+    /// kickAndDrift's answer: whether a free particle may touch the ground.
+    bool below() const { return kick_.floor == Contact::kNoFloor || below_.load(); }
+
+private:
+    KickDrift kick_;
+    BlowUpGuard& guard_;
+    BlowUpGuard::State state_;
+    int first_;
+    std::unique_ptr<std::atomic<int>[]> left_;
+    std::atomic<int> moved_{0};
+    std::atomic<bool> below_{false};
+};
+
+}  // namespace
+
+// Nothing may add to the forces between the solver's pass and the kick, and the step must be
+// one piece (the pass cannot take back a kick): a fixed step is cut only by the power law's
+// stiffening, which its pass never moves, and by colliders or self-contact (the ground alone
+// limits nothing, and it pushes out after the drift as before).
+bool Membrane::mayKickInPass() const {
+    return kickInPass_ && !solver_->carriesMomentum() && params_.pressure == 0.0 &&
+           !(contact_ && contact_->limitsStep());
+}
+
 void Membrane::stepSymplecticEuler() {
-    accumulateForces();  // at x^n
+    std::vector<double> prescribed;
+    std::optional<KickInPass> inPass;
+    if (mayKickInPass())
+        inPass.emplace(kickDriftOf(kickBefore(dt_), dt_, time_ + dt_, prescribed), guard_,
+                       motionState(), begin_, end_);
+    accumulateForces(inPass ? &*inPass : nullptr);  // at x^n
     const int pieces = piecesOfStep();
+    keptKickInPass_ = inPass && inPass->moved() > 0;
+    if (keptKickInPass_) {
+        if (pieces != 1 || inPass->moved() != end_ - begin_)
+            throw std::logic_error("the force pass moved the particles of a step in pieces");
+        guard_.endMotion();
+        integrate(dt_, time_ + dt_, inPass->below());
+        forcesCurrent_ = false;
+        return;
+    }
     double done = 0.0;
     for (int k = 0; k < pieces; ++k) {
         if (k > 0) accumulateForces();

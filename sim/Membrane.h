@@ -31,6 +31,7 @@
 #include "sim/Remesh.h"
 #include "sim/Solver.h"
 #include "sim/StateArchive.h"
+#include "sim/StepKernels.h"
 #include "sim/TimeStep.h"
 
 namespace rend::sim {
@@ -90,6 +91,12 @@ public:
     /// elastoplastic ones), then velocities, then positions, then theta. Throws
     /// NumericalBlowUp naming the step and the first offending particle.
     void step();
+    /// Whether a step may move the particles inside the solver's force pass (StepState::motion:
+    /// the same bits, fewer trips to memory); on by default. Off: the kick and drift after the
+    /// pass, as before (tests and benchmarks compare the two).
+    void setKickInPass(bool on) { kickInPass_ = on; }
+    /// Whether the last step's particles moved inside the force pass.
+    bool keptKickInPass() const { return keptKickInPass_; }
 
     /// Adaptive stepping (time.dt = "adaptive", sim/TimeStep.h): steps until time() is exactly
     /// tEnd, each step from the controller, the last ones evened out to land on tEnd.
@@ -176,7 +183,9 @@ private:
     void setStableStep(double worstRatio);
     /// Hands the internal forces to `solver` and takes its stable step.
     void useSolver(std::unique_ptr<Solver> solver);
-    void accumulateForces();  ///< the solver's (updating its state) and pressure into force_
+    /// The solver's forces (updating its state) and pressure into force_; a non-null `motion`
+    /// lets the solver move the particles as it goes (StepState::motion).
+    void accumulateForces(BlockMotion* motion = nullptr);
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
     void stepSymplecticEuler();
     void stepVelocityVerlet();
@@ -191,7 +200,18 @@ private:
     void assignBoundaries();
     Eigen::Vector3d boundaryVelocity(int k, double t) const;
     /// Velocities then positions over h, with boundary velocities at tNext (eq. 26).
-    void integrate(double h, double tNext);
+    /// `moved`: the force pass already kicked and drifted (stepSymplecticEuler), with
+    /// kickAndDrift's answer; only the contact and the ghosts are left.
+    void integrate(double h, double tNext, std::optional<bool> moved = std::nullopt);
+    /// Whether this step's kick and drift may run inside the force pass: symplectic Euler in
+    /// one piece, nothing added to the forces after the solver's, no colliders but the ground.
+    bool mayKickInPass() const;
+    /// The kick that goes with a drift of dt (integrate's).
+    double kickBefore(double dt) const { return lastDrift_ > 0.0 ? 0.5 * (lastDrift_ + dt) : dt; }
+    /// The kick of h and drift of dt with boundary velocities at tNext (held by `prescribed`).
+    KickDrift kickDriftOf(double h, double dt, double tNext, std::vector<double>& prescribed);
+    /// What the blow-up guard samples of the motion.
+    BlowUpGuard::State motionState() const;
     /// integrate's kick of h and drift of dt over this process's particles (not the MPM's);
     /// false where the ground is the only collider and no free particle reached it.
     bool kickAndDrift(double h, double dt, double tNext);
@@ -254,6 +274,7 @@ private:
     std::vector<std::int16_t> constraint_;  ///< kFree, kPinned or a boundary index
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
+    bool kickInPass_ = true, keptKickInPass_ = false;
     bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
     /// At least every particle's |v| since the last check (StepState::speedBound), or -1 once v
     /// may have changed: the guard's largest free speed, and the boundaries' speeds.

@@ -559,7 +559,18 @@ private:
     double ring_[kRing];
 };
 
+void moveRange(BlockMotion& motion, int begin, int end) {
+    if (begin < end) motion.move(begin, end);
+}
+
 }  // namespace
+
+// The motion a step's pass takes on: none for the power law, whose look-ahead may cut the step
+// into pieces only once every pair is seen (Membrane::piecesOfStep), after the first blocks
+// would have moved.
+BlockMotion* PeridynamicBonds::movingMotion(const StepState& s) const {
+    return law_.kind == BondLawKind::PowerLaw ? nullptr : s.motion;
+}
 
 template <bool kUpdateBonds, bool kBreak>
 void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
@@ -651,6 +662,14 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                           rows,
                           streamsForces(slab_.end - slab_.ghostBegin),
                           rowStride_};
+        // Each block moved as soon as it is summed (StepState::motion), while its forces,
+        // positions and velocities are in cache: a block's pairs read the positions of the
+        // particles up to reach_ past it and never before it, so this thread reads a summed
+        // block no more; the thread before reads this thread's first reach_ particles, moved
+        // after the barrier at the end. The forces are read back at once: not streamed.
+        BlockMotion* const motion = kUpdateBonds ? movingMotion(s) : nullptr;
+        const int settled = t == 0 ? from : std::min(to, from + reach_);
+        if (motion) gather.stream = false;
         for (int p = from; p < to; p += kFusedBlock) {
             const int q = std::min(to, p + kFusedBlock);
             // The first pair of the block after next, asked for now: on a sheet that streams
@@ -659,6 +678,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             __builtin_prefetch(&tileBegin_[std::min(q + 2 * kFusedBlock, n) / kTile]);
             stiffest = std::max(stiffest, compute(own, p, q));
             gatherPairForces(gather, std::max(p, slab_.begin), q);
+            if (motion) moveRange(*motion, std::max({p, slab_.begin, settled}), q);
+        }
+        if (motion) {
+#pragma omp barrier
+            moveRange(*motion, std::max(from, slab_.begin), settled);
         }
     }
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;

@@ -125,6 +125,8 @@ private:
     void vectorBondForces(const StepState& s, PairWorkspace& work,
                           std::vector<Eigen::Vector3d>& force, Updates& updates) const;
     void setUpPairArrays();
+    /// StepState::motion where the vectorised pass moves the particles, else null.
+    BlockMotion* movingMotion(const StepState& s) const;
     /// Particles per block of the fused pair pass and gather.
     static constexpr int kFusedBlock = 512;
     /// Whether the force loop takes sim/PairKernels.h's vectorised pass: the linear law, the

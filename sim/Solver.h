@@ -32,6 +32,19 @@ namespace rend::sim {
 struct SolverSetUp;  // sim/SolverRegistry.h: what a solver's factory builds it from
 class Contact;       // sim/Contact.h: the ground and colliders a grid's nodes collide with
 
+/// The step's motion of a range of particles, handed to a solver's advance() (StepState::motion)
+/// so that it can move each block of particles as soon as its forces are final, while they are
+/// still in cache (Membrane's kick and drift and the blow-up guard's sample: at 10^6 particles
+/// the separate pass read the forces, positions and velocities back from memory).
+class BlockMotion {
+public:
+    virtual ~BlockMotion() = default;
+    /// Moves particles [begin, end) by their forces. A solver that calls it calls it once for
+    /// each particle it owns, from any of its threads, after which it reads none of their
+    /// positions or velocities again in that advance().
+    virtual void move(int begin, int end) = 0;
+};
+
 /// One step's state, passed explicitly.
 struct StepState {
     std::span<const Eigen::Vector3d> x;  ///< positions
@@ -44,6 +57,9 @@ struct StepState {
     /// At least every particle's speed |v|, or < 0 where unknown (Membrane::speedBound): the
     /// power law's look-ahead then bounds its pairs' rates from it instead of reading v.
     double speedBound = -1.0;
+    /// Non-null: advance() may move the particles through it instead of leaving that to the
+    /// caller (the caller asks the motion whether it moved them). forces() never does.
+    BlockMotion* motion = nullptr;
 };
 
 /// What Membrane::failureApproachRate measures a step by (its constants).

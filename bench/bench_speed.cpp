@@ -3,8 +3,8 @@
 // particles at the same spacing. Per size: the bonds per particle, the bytes per particle (the
 // heap the membrane and its first steps hold), and ns per particle-step on 1 thread
 // and on every usable core, with the speed-up. When `lmp` is on the PATH, LAMMPS runs the
-// 10,201-particle sheet with peri/pmb three times in the same run (first, after the per-law
-// rows, last), and the median's ratio to rend is printed, per law too. Then,
+// 10,201-particle sheet with peri/pmb just before and just after each one-thread figure it is
+// compared with, on the same core, and the faster run's ratio to rend is printed. Then,
 // per bond law (linear, power_law, elastoplastic), ns per particle-step on 1 thread of the same
 // sheet, and of crack_path_sources (its notch breaking, two heat sources diffusing: theta and
 // breaking on), both square at dt 1e-4; with --largest 1e6 or more, crack_path_sources too on a
@@ -12,11 +12,19 @@
 // elastoplastic laws again with the kick and drift in their own pass after the forces
 // (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves.
 //
-//   build/bench_speed [--largest N]   (default 10000000; sizes 1e4, 1e5, 1e6, 1e7 up to it)
+// Every rend figure is the fastest of five spans of its steps, and the one-thread rows and
+// LAMMPS run pinned to one core, the fastest of the usable ones by a dependent add loop at the
+// start (or --cpu K). On this VM a core loses up to a third of its speed for minutes at a time
+// to another guest: on 2026-11-28 one core ran 2.5 dependent adds per ns and the other 3.5,
+// then both 3.5 half an hour later (LAMMPS 105 ns on the one, 157 on the other), so a median or
+// a mean of runs minutes apart, or on either core, measures that guest.
+//
+//   build/bench_speed [--largest N] [--cpu K]   (sizes 1e4, 1e5, 1e6, 1e7 up to N, default 1e7)
 //   REND_SIMD=avx2 build/bench_speed  (the four-lane kernels on a CPU with AVX-512)
 
 #include <malloc.h>
 #include <omp.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,6 +35,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -52,17 +61,83 @@ double heapBytes() {
     return double(m.uordblks) + double(m.hblkhd);
 }
 
-/// ns per particle-step over enough steps to take about `seconds` (at least 3).
+/// The calling thread on one CPU while it lives (children started meanwhile inherit it), its
+/// own mask back after; nothing where `cpu` is negative or the kernel refuses.
+class PinnedThread {
+public:
+    explicit PinnedThread(int cpu) {
+        if (cpu < 0 || sched_getaffinity(0, sizeof saved_, &saved_) != 0) return;
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET(cpu, &one);
+        pinned_ = sched_setaffinity(0, sizeof one, &one) == 0;
+    }
+    ~PinnedThread() {
+        if (pinned_) sched_setaffinity(0, sizeof saved_, &saved_);
+    }
+    PinnedThread(const PinnedThread&) = delete;
+    PinnedThread& operator=(const PinnedThread&) = delete;
+
+private:
+    cpu_set_t saved_{};
+    bool pinned_ = false;
+};
+
+/// The core the one-thread rows and LAMMPS run on (-1: wherever the scheduler puts them).
+int gOneCore = -1;
+
+/// Dependent integer adds per ns on `cpu`: the best of five loops of 2e7 (a few ms each).
+double addsPerNs(int cpu) {
+    const PinnedThread pin(cpu);
+    constexpr long kAdds = 20000000;
+    double best = 0.0;
+    for (int round = 0; round < 5; ++round) {
+        unsigned long x = 0;
+        const auto start = Clock::now();
+        for (long k = 0; k < kAdds; ++k) {
+            asm volatile("" : "+r"(x));  // one dependent add per iteration, kept in a register
+            ++x;
+        }
+        best = std::max(best, kAdds / std::max(secondsSince(start), 1e-9) * 1e-9);
+    }
+    return best;
+}
+
+/// The fastest CPU of the affinity mask by addsPerNs, each one's speed printed.
+int fastestCpu() {
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) != 0) return -1;
+    int best = -1;
+    double bestSpeed = 0.0;
+    std::printf("core speeds (dependent adds per ns):");
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+        if (!CPU_ISSET(cpu, &set)) continue;
+        const double speed = addsPerNs(cpu);
+        std::printf(" cpu %d %.2f", cpu, speed);
+        if (speed > bestSpeed) best = cpu, bestSpeed = speed;
+    }
+    return best;
+}
+
+/// ns per particle-step over enough steps to take about `seconds`, the fastest of kSpans spans
+/// of at least 2 steps each (time another process takes from a core only adds); on one thread,
+/// on gOneCore.
 double nsPerParticleStep(rend::sim::Membrane& membrane, int threads, double seconds) {
+    constexpr int kSpans = 5;
+    const PinnedThread pin(threads == 1 ? gOneCore : -1);
     omp_set_num_threads(threads);
     membrane.step();  // the first step at this count pays for the thread pool
     auto start = Clock::now();
     membrane.step();
     const double one = std::max(secondsSince(start), 1e-6);
-    const int steps = std::max(3, int(seconds / one));
-    start = Clock::now();
-    for (int s = 0; s < steps; ++s) membrane.step();
-    return secondsSince(start) / steps / membrane.particleCount() * 1e9;
+    const int steps = std::max(2, int(seconds / kSpans / one));
+    double best = std::numeric_limits<double>::infinity();
+    for (int span = 0; span < kSpans; ++span) {
+        start = Clock::now();
+        for (int s = 0; s < steps; ++s) membrane.step();
+        best = std::min(best, secondsSince(start) / steps / membrane.particleCount() * 1e9);
+    }
+    return best;
 }
 
 struct Row {
@@ -131,6 +206,7 @@ run 500
 )";
     const std::string command =
         "cd '" + dir.string() + "' && OMP_NUM_THREADS=1 lmp -in in.peri -log none > out.txt 2>&1";
+    const PinnedThread pin(gOneCore);  // the same core as rend's one-thread rows
     const int status = std::system(command.c_str());
     std::ifstream in(dir / "out.txt");
     std::stringstream text;
@@ -166,12 +242,33 @@ double lawRow(const std::string& scene, const char* law, double side = 0.0, int 
     return nsPerParticleStep(membrane, 1, 2.0);
 }
 
+/// A figure of rend's with LAMMPS's runs just before and after it on the same core (gOneCore),
+/// the faster of the two: this VM's cores slow down for minutes at a time, so a ratio means
+/// something only between runs seconds apart. lammps is negative without them.
+struct Paired {
+    double ns = 0.0, lammps = -1.0;
+    double ratio() const { return lammps > 0.0 ? lammps / ns : -1.0; }
+};
+
+template <class Figure>
+Paired paired(bool withLammps, Figure&& figure) {
+    const double before = withLammps ? lammpsNsPerParticleStep() : -1.0;
+    Paired p{figure(), -1.0};
+    const double after = withLammps ? lammpsNsPerParticleStep() : -1.0;
+    for (const double ns : {before, after})
+        if (ns > 0.0 && (p.lammps < 0.0 || ns < p.lammps)) p.lammps = ns;
+    return p;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     long largest = 10000000;
-    for (int k = 1; k + 1 < argc; ++k)
+    int cpu = -1;
+    for (int k = 1; k + 1 < argc; ++k) {
         if (std::string(argv[k]) == "--largest") largest = std::atol(argv[k + 1]);
+        if (std::string(argv[k]) == "--cpu") cpu = std::atoi(argv[k + 1]);
+    }
     const int cores = rend::usableCores();
     const int width = rend::sim::simdWidth();
     std::printf(
@@ -181,62 +278,76 @@ int main(int argc, char** argv) {
         width == 8   ? "AVX-512"
         : width == 4 ? "AVX2"
                      : "scalar");
+    gOneCore = fastestCpu();
+    if (cpu >= 0) gOneCore = cpu;
+    std::printf("; the 1-thread rows and LAMMPS on cpu %d\n", gOneCore);
     std::printf("%12s %10s %12s %10s %14s %14s %8s\n", "particles", "bonds/p", "bytes/p", "setup s",
                 "ns/p-step 1t", "ns/p-step all", "speedup");
     // The per-law rows first, while the machine is quiet: freeing the 10^7 sheet's 9 GB keeps
     // the kernel busy for a while after it.
-    // LAMMPS before the per-law rows, after them and at the end: this VM's speed drifts by up
-    // to twofold between days and by tens of percent within minutes, so the ratios take the
-    // median of three runs spread over the benchmark's minutes.
-    std::vector<double> lammps{lammpsNsPerParticleStep()};
-    std::vector<std::array<double, 3>> laws;
+    const bool lmp = std::system("command -v lmp > /dev/null 2>&1") == 0;
+    std::vector<std::array<Paired, 3>> laws;
     const bool large = largest >= 1000000;
-    for (const char* law : kLaws)
-        laws.push_back({lawRow("stretch.toml", law), lawRow("crack_path_sources.toml", law),
-                        large ? lawRow("crack_path_sources.toml", law, 20.0, 20) : 0.0});
-    for (const int k : {0, 2})  // the kick in its own pass
-        laws.push_back(
-            {lawRow("stretch.toml", kLaws[k], 0.0, 200, false),
-             lawRow("crack_path_sources.toml", kLaws[k], 0.0, 200, false),
-             large ? lawRow("crack_path_sources.toml", kLaws[k], 20.0, 20, false) : 0.0});
-    lammps.push_back(lammpsNsPerParticleStep());
-    double rendAt1e4 = 0.0;
+    const auto row = [&](const char* law, bool kickInPass) {
+        return std::array<Paired, 3>{
+            paired(lmp, [&] { return lawRow("stretch.toml", law, 0.0, 200, kickInPass); }),
+            paired(lmp,
+                   [&] { return lawRow("crack_path_sources.toml", law, 0.0, 200, kickInPass); }),
+            large ? paired(lmp,
+                           [&] {
+                               return lawRow("crack_path_sources.toml", law, 20.0, 20, kickInPass);
+                           })
+                  : Paired{}};
+    };
+    for (const char* law : kLaws) laws.push_back(row(law, true));
+    for (const int k : {0, 2}) laws.push_back(row(kLaws[k], false));  // the kick in its own pass
+    Paired at1e4;
     for (const int side : {101, 317, 1001, 3163}) {
         if (side > 101 && long(side) * side > largest * 1.01) break;  // 10^4 always runs
-        const Row r = measure(stretchSheet(side), cores);
-        if (side == 101) rendAt1e4 = r.ns1;
+        Row r;
+        const Paired p = paired(lmp && side == 101, [&] {
+            r = measure(stretchSheet(side), cores);
+            return r.ns1;
+        });
+        if (side == 101) at1e4 = p;
         std::printf("%12ld %10.2f %12.0f %10.2f %14.1f %14.1f %8.2f\n", r.particles,
                     r.bondsPerParticle, r.bytesPerParticle, r.setupSeconds, r.ns1, r.nsAll,
                     r.ns1 / r.nsAll);
         std::fflush(stdout);
     }
-    lammps.push_back(lammpsNsPerParticleStep());
-    std::sort(lammps.begin(), lammps.end());
-    const double lammpsNs = lammps[1];  // the median; a failed run (-1) sorts first
-    if (lammps[0] < 0.0) {
+    if (at1e4.lammps < 0.0) {
         std::printf("LAMMPS: lmp not found or its run failed: no ratio (apt-get install lammps)\n");
     } else {
         std::printf(
-            "LAMMPS peri/pmb, 10,201 particles, 1 thread: %.1f / %.1f / %.1f ns per particle-step "
-            "(three runs, sorted); rend %.1f: rend is %.2fx faster than the median\n",
-            lammps[0], lammps[1], lammps[2], rendAt1e4, lammpsNs / rendAt1e4);
+            "LAMMPS peri/pmb, 10,201 particles, 1 thread, on the same core just before and after "
+            "rend's row: %.1f ns per particle-step (the faster run); rend %.1f: rend is %.2fx "
+            "faster\n",
+            at1e4.lammps, at1e4.ns, at1e4.lammps / at1e4.ns);
     }
     std::printf("\nns per particle-step, 1 thread, square lattice, dt 1e-4, per bond law\n");
-    std::printf("%-30s %18s %36s %26s\n", "law", "stretch (10,201)",
+    std::printf("%-32s %18s %36s %26s\n", "law", "stretch (10,201)",
                 "crack_path_sources (theta, breaking)", "the same at 1,002,001");
     const char* names[] = {kLaws[0], kLaws[1], kLaws[2], "linear, kick in own pass",
                            "elastoplastic, kick in own pass"};
     for (std::size_t k = 0; k < laws.size(); ++k) {
-        std::printf("%-30s %18.1f %36.1f", names[k], laws[k][0], laws[k][1]);
-        if (large) std::printf(" %26.1f", laws[k][2]);
+        std::printf("%-32s %18.1f %36.1f", names[k], laws[k][0].ns, laws[k][1].ns);
+        if (large) std::printf(" %26.1f", laws[k][2].ns);
         std::printf("\n");
     }
-    if (lammps[0] < 0.0) return 0;
-    std::printf("\nthe same as times faster than LAMMPS peri/pmb's median (issue 16: 10x)\n");
+    if (!lmp) return 0;
+    std::printf(
+        "\nthe same as times faster than LAMMPS peri/pmb (10,201 particles) run on the same core "
+        "just before and after each figure (issue 16: 10x)\n");
+    double slowest = 0.0, fastest = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < laws.size(); ++k) {
-        std::printf("%-30s %17.1fx %35.1fx", names[k], lammpsNs / laws[k][0],
-                    lammpsNs / laws[k][1]);
-        if (large) std::printf(" %25.1fx", lammpsNs / laws[k][2]);
+        for (int c = 0; c < (large ? 3 : 2); ++c) {
+            slowest = std::max(slowest, laws[k][c].lammps);
+            fastest = std::min(fastest, laws[k][c].lammps);
+        }
+        std::printf("%-32s %17.1fx %35.1fx", names[k], laws[k][0].ratio(), laws[k][1].ratio());
+        if (large) std::printf(" %25.1fx", laws[k][2].ratio());
         std::printf("\n");
     }
+    std::printf("(LAMMPS's figure beside them: %.1f to %.1f ns per particle-step)\n", fastest,
+                slowest);
 }

@@ -8,7 +8,8 @@
 // per bond law (linear, power_law, elastoplastic), ns per particle-step on 1 thread of the same
 // sheet, and of crack_path_sources (its notch breaking, two heat sources diffusing: theta and
 // breaking on), both square at dt 1e-4; with --largest 1e6 or more, crack_path_sources too on a
-// sheet 20 m square at its spacing (1,002,001 particles, 20 steps in). The linear and
+// sheet 20 m square at its spacing (1,002,001 particles, 20 steps in), and with 1e7 on one
+// 63.24 m square (10,004,569 particles, 5 steps in). The linear and
 // elastoplastic laws again with the kick and drift in their own pass after the forces
 // (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves.
 //
@@ -286,18 +287,20 @@ int main(int argc, char** argv) {
     // The per-law rows first, while the machine is quiet: freeing the 10^7 sheet's 9 GB keeps
     // the kernel busy for a while after it.
     const bool lmp = std::system("command -v lmp > /dev/null 2>&1") == 0;
-    std::vector<std::array<Paired, 3>> laws;
-    const bool large = largest >= 1000000;
+    std::vector<std::array<Paired, 4>> laws;
+    // crack_path_sources at 10^6 and at 10^7 particles too, where --largest reaches them (the
+    // kick in its own pass not at 10^7: a minute's set-up for each row).
+    const bool large = largest >= 1000000, huge = largest >= 10000000;
     const auto row = [&](const char* law, bool kickInPass) {
-        return std::array<Paired, 3>{
+        const auto crack = [&](double side, int warm) {
+            return paired(lmp, [&] {
+                return lawRow("crack_path_sources.toml", law, side, warm, kickInPass);
+            });
+        };
+        return std::array<Paired, 4>{
             paired(lmp, [&] { return lawRow("stretch.toml", law, 0.0, 200, kickInPass); }),
-            paired(lmp,
-                   [&] { return lawRow("crack_path_sources.toml", law, 0.0, 200, kickInPass); }),
-            large ? paired(lmp,
-                           [&] {
-                               return lawRow("crack_path_sources.toml", law, 20.0, 20, kickInPass);
-                           })
-                  : Paired{}};
+            crack(0.0, 200), large ? crack(20.0, 20) : Paired{},
+            huge && kickInPass ? crack(63.24, 5) : Paired{}};
     };
     for (const char* law : kLaws) laws.push_back(row(law, true));
     for (const int k : {0, 2}) laws.push_back(row(kLaws[k], false));  // the kick in its own pass
@@ -325,29 +328,41 @@ int main(int argc, char** argv) {
             at1e4.lammps, at1e4.ns, at1e4.lammps / at1e4.ns);
     }
     std::printf("\nns per particle-step, 1 thread, square lattice, dt 1e-4, per bond law\n");
-    std::printf("%-32s %18s %36s %26s\n", "law", "stretch (10,201)",
-                "crack_path_sources (theta, breaking)", "the same at 1,002,001");
+    const int columns = 2 + int(large) + int(huge);
+    const char* headers[] = {"stretch (10,201)", "crack_path_sources (theta, breaking)",
+                             "the same at 1,002,001", "the same at 10,004,569"};
+    const int widths[] = {18, 36, 26, 26};
     const char* names[] = {kLaws[0], kLaws[1], kLaws[2], "linear, kick in own pass",
                            "elastoplastic, kick in own pass"};
-    for (std::size_t k = 0; k < laws.size(); ++k) {
-        std::printf("%-32s %18.1f %36.1f", names[k], laws[k][0].ns, laws[k][1].ns);
-        if (large) std::printf(" %26.1f", laws[k][2].ns);
-        std::printf("\n");
-    }
+    const auto table = [&](auto&& cell) {
+        for (std::size_t k = 0; k < laws.size(); ++k) {
+            std::printf("%-32s", names[k]);
+            for (int c = 0; c < columns; ++c) cell(laws[k][c], widths[c]);
+            std::printf("\n");
+        }
+    };
+    std::printf("%-32s", "law");
+    for (int c = 0; c < columns; ++c) std::printf(" %*s", widths[c], headers[c]);
+    std::printf("\n");
+    table([](const Paired& p, int width) {
+        if (p.ns > 0.0)
+            std::printf(" %*.1f", width, p.ns);
+        else
+            std::printf(" %*s", width, "-");
+    });
     if (!lmp) return 0;
     std::printf(
         "\nthe same as times faster than LAMMPS peri/pmb (10,201 particles) run on the same core "
         "just before and after each figure (issue 16: 10x)\n");
     double slowest = 0.0, fastest = std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < laws.size(); ++k) {
-        for (int c = 0; c < (large ? 3 : 2); ++c) {
-            slowest = std::max(slowest, laws[k][c].lammps);
-            fastest = std::min(fastest, laws[k][c].lammps);
+    table([&](const Paired& p, int width) {
+        if (p.lammps > 0.0) {
+            slowest = std::max(slowest, p.lammps), fastest = std::min(fastest, p.lammps);
+            std::printf(" %*.1fx", width - 1, p.ratio());
+        } else {
+            std::printf(" %*s", width, "-");
         }
-        std::printf("%-32s %17.1fx %35.1fx", names[k], laws[k][0].ratio(), laws[k][1].ratio());
-        if (large) std::printf(" %25.1fx", laws[k][2].ratio());
-        std::printf("\n");
-    }
+    });
     std::printf("(LAMMPS's figure beside them: %.1f to %.1f ns per particle-step)\n", fastest,
                 slowest);
 }

@@ -11,7 +11,9 @@
 // sheet 20 m square at its spacing (1,002,001 particles, 20 steps in), and with 1e7 on one
 // 63.24 m square (10,004,569 particles, 5 steps in). The linear and
 // elastoplastic laws again with the kick and drift in their own pass after the forces
-// (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves.
+// (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves. And the
+// diffusion alone (eq. 25, Diffusion::advance) of the linear law's crack_path_sources sheets,
+// after their steps: ns per particle-step on 1 thread.
 //
 // Every rend figure is the fastest of five spans of its steps, and the one-thread rows and
 // LAMMPS run pinned to one core, the fastest of the usable ones by a dependent add loop at the
@@ -44,6 +46,7 @@
 
 #include "app/Scene.h"
 #include "app/Threads.h"
+#include "sim/Diffusion.h"
 #include "sim/Membrane.h"
 #include "sim/StepKernels.h"
 
@@ -120,25 +123,51 @@ int fastestCpu() {
     return best;
 }
 
-/// ns per particle-step over enough steps to take about `seconds`, the fastest of kSpans spans
-/// of at least 2 steps each (time another process takes from a core only adds); on one thread,
-/// on gOneCore.
-double nsPerParticleStep(rend::sim::Membrane& membrane, int threads, double seconds) {
+/// ns per particle of `step` (one step of `particles`), over enough steps to take about
+/// `seconds`: the fastest of kSpans spans of at least 2 steps each (time another process takes
+/// from a core only adds).
+template <class Step>
+double fastestSpan(Step&& step, int particles, double seconds) {
     constexpr int kSpans = 5;
-    const PinnedThread pin(threads == 1 ? gOneCore : -1);
-    omp_set_num_threads(threads);
-    membrane.step();  // the first step at this count pays for the thread pool
+    step();  // the first step at this thread count pays for the thread pool
     auto start = Clock::now();
-    membrane.step();
+    step();
     const double one = std::max(secondsSince(start), 1e-6);
     const int steps = std::max(2, int(seconds / kSpans / one));
     double best = std::numeric_limits<double>::infinity();
     for (int span = 0; span < kSpans; ++span) {
         start = Clock::now();
-        for (int s = 0; s < steps; ++s) membrane.step();
-        best = std::min(best, secondsSince(start) / steps / membrane.particleCount() * 1e9);
+        for (int s = 0; s < steps; ++s) step();
+        best = std::min(best, secondsSince(start) / steps / particles * 1e9);
     }
     return best;
+}
+
+/// ns per particle-step of the membrane (fastestSpan); on one thread, on gOneCore.
+double nsPerParticleStep(rend::sim::Membrane& membrane, int threads, double seconds) {
+    const PinnedThread pin(threads == 1 ? gOneCore : -1);
+    omp_set_num_threads(threads);
+    return fastestSpan([&] { membrane.step(); }, membrane.particleCount(), seconds);
+}
+
+/// ns per particle-step of the diffusion alone (eq. 25: Diffusion::advance, with the sub-steps
+/// the step needs), on one thread on gOneCore: a diffusion built as the membrane builds its
+/// own, advancing a copy of the membrane's theta over its bonds' life.
+double diffusionNsPerParticleStep(const rend::sim::Membrane& membrane, double seconds) {
+    rend::sim::Diffusion diffusion(membrane.params(), membrane.restPositions(), membrane.bonds(),
+                                   membrane.volumes());
+    std::vector<double> theta = membrane.theta();
+    const rend::sim::DamageState& damage = membrane.damageState();
+    double t = membrane.time();
+    const double dt = membrane.timeStep();
+    const PinnedThread pin(gOneCore);
+    omp_set_num_threads(1);
+    return fastestSpan(
+        [&] {
+            diffusion.advance(theta, damage.bondAlive(), damage.version(), t, dt);
+            t += dt;
+        },
+        membrane.particleCount(), seconds);
 }
 
 struct Row {
@@ -226,8 +255,10 @@ constexpr const char* kLaws[] = {"linear", "power_law", "elastoplastic"};
 
 /// ns per particle-step on 1 thread of `scene` with [material] law = `law`, after `warm` steps;
 /// with `side` > 0, on a sheet `side` metres square at the scene's spacing.
+/// With `diffusion`, the diffusion alone of the same membrane after the steps
+/// (diffusionNsPerParticleStep) too.
 double lawRow(const std::string& scene, const char* law, double side = 0.0, int warm = 200,
-              bool kickInPass = true) {
+              bool kickInPass = true, double* diffusion = nullptr) {
     std::vector<std::string> sets = {"sheet.lattice=\"square\"", "time.dt=1e-4",
                                      std::string("material.law=\"") + law + "\""};
     if (side > 0.0) {
@@ -240,7 +271,9 @@ double lawRow(const std::string& scene, const char* law, double side = 0.0, int 
     membrane.setKickInPass(kickInPass);
     omp_set_num_threads(1);
     for (int k = 0; k < warm; ++k) membrane.step();
-    return nsPerParticleStep(membrane, 1, 2.0);
+    const double ns = nsPerParticleStep(membrane, 1, 2.0);
+    if (diffusion) *diffusion = diffusionNsPerParticleStep(membrane, 1.0);
+    return ns;
 }
 
 /// A figure of rend's with LAMMPS's runs just before and after it on the same core (gOneCore),
@@ -291,10 +324,14 @@ int main(int argc, char** argv) {
     // crack_path_sources at 10^6 and at 10^7 particles too, where --largest reaches them (the
     // kick in its own pass not at 10^7: a minute's set-up for each row).
     const bool large = largest >= 1000000, huge = largest >= 10000000;
+    std::array<double, 4> diffusion{};  // the diffusion alone, of the linear law's membranes
     const auto row = [&](const char* law, bool kickInPass) {
+        const bool linear = std::string(law) == "linear" && kickInPass;
+        int cell = 0;
         const auto crack = [&](double side, int warm) {
+            double* alone = linear ? &diffusion[++cell] : nullptr;
             return paired(lmp, [&] {
-                return lawRow("crack_path_sources.toml", law, side, warm, kickInPass);
+                return lawRow("crack_path_sources.toml", law, side, warm, kickInPass, alone);
             });
         };
         return std::array<Paired, 4>{
@@ -350,6 +387,9 @@ int main(int argc, char** argv) {
         else
             std::printf(" %*s", width, "-");
     });
+    std::printf("%-32s %*s", "diffusion alone (linear's)", widths[0], "-");
+    for (int c = 1; c < columns; ++c) std::printf(" %*.1f", widths[c], diffusion[c]);
+    std::printf("\n");
     if (!lmp) return 0;
     std::printf(
         "\nthe same as times faster than LAMMPS peri/pmb (10,201 particles) run on the same core "

@@ -299,9 +299,10 @@ Paired paired(bool withLammps, Figure&& figure) {
 int main(int argc, char** argv) {
     long largest = 10000000;
     int cpu = -1;
+    bool cpuGiven = false;
     for (int k = 1; k + 1 < argc; ++k) {
         if (std::string(argv[k]) == "--largest") largest = std::atol(argv[k + 1]);
-        if (std::string(argv[k]) == "--cpu") cpu = std::atoi(argv[k + 1]);
+        if (std::string(argv[k]) == "--cpu") cpu = std::atoi(argv[k + 1]), cpuGiven = true;
     }
     const int cores = rend::usableCores();
     const int width = rend::sim::simdWidth();
@@ -313,7 +314,19 @@ int main(int argc, char** argv) {
         : width == 4 ? "AVX2"
                      : "scalar");
     gOneCore = fastestCpu();
-    if (cpu >= 0) gOneCore = cpu;
+    if (cpuGiven) {
+        cpu_set_t set;
+        if (cpu < 0 || cpu >= CPU_SETSIZE || sched_getaffinity(0, sizeof set, &set) != 0 ||
+            !CPU_ISSET(cpu, &set)) {
+            std::fflush(stdout);
+            std::fprintf(stderr,
+                         "\nbench_speed: --cpu %d is not one of the CPUs this process may use "
+                         "(the core speeds above list them)\n",
+                         cpu);
+            return 2;
+        }
+        gOneCore = cpu;
+    }
     std::printf("; the 1-thread rows and LAMMPS on cpu %d\n", gOneCore);
     std::printf("%12s %10s %12s %10s %14s %14s %8s\n", "particles", "bonds/p", "bytes/p", "setup s",
                 "ns/p-step 1t", "ns/p-step all", "speedup");

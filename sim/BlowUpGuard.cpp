@@ -139,12 +139,11 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
     blocks_.assign(blocks, Sample{});
     // The motion the integrator sampled as it went, and theta now; else both now.
     const bool sampled = motionReady_ && motionFirst_ == first && motionLast_ == n;
-#pragma omp parallel for schedule(static) if (n - first >= kParallelThreshold)
-    for (int b = 0; b < blocks; ++b) {
+    forEachIndex(n - first >= kParallelThreshold, 0, blocks, [&](int b) {
         const int begin = first + b * kBlock, end = std::min(n, begin + kBlock);
         if (!sampled) {
             sampleBlock(s, begin, end, blocks_[b]);
-            continue;
+            return;
         }
         GuardSums sums{motion_[b].kinetic,      motion_[b].boundaryPower,
                        motion_[b].gravityPower, motion_[b].maxSpeedSquared,
@@ -152,7 +151,7 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
                        motion_[b].firstBad};
         if (!s.theta.empty()) addThetaSums(sums, guardThetaSums(s.theta.data(), begin, end));
         blocks_[b] = sampleOf(sums);
-    }
+    });
     Sample total;
     for (const Sample& b : blocks_) {
         total.kinetic += b.kinetic;

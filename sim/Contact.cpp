@@ -47,10 +47,10 @@ T blockSum(int n, T zero, F&& f) {
     constexpr int kBlock = 4096;
     const int blocks = (n + kBlock - 1) / kBlock;
     std::vector<T> part(std::size_t(blocks), zero);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int b = 0; b < blocks; ++b)
+    forEachIndex(n >= kParallelThreshold, 0, blocks, [&](int b) {
         for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
             part[std::size_t(b)] += f(i);
+    });
     T sum = zero;
     for (const T& p : part) sum += p;
     return sum;
@@ -196,8 +196,7 @@ void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eige
     constexpr int kBlock = 4096;
     const int blocks = (n + kBlock - 1) / kBlock;
     std::vector<Eigen::Vector4d> part(std::size_t(blocks), Eigen::Vector4d::Zero());
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int b = 0; b < blocks; ++b)
+    forEachIndex(n >= kParallelThreshold, 0, blocks, [&](int b) {
         for (int i = first + b * kBlock; i < first + std::min(n, (b + 1) * kBlock); ++i) {
             if (!free[i] || (!colliders && x[i].z() >= floor)) continue;
             const Eigen::Vector3d before = v[i];
@@ -205,6 +204,7 @@ void Contact::resolveColliders(std::vector<Eigen::Vector3d>& x, std::vector<Eige
             const Eigen::Vector3d p = mass[i] * (v[i] - before);
             part[std::size_t(b)] += Eigen::Vector4d(p.x(), p.y(), p.z(), p.norm());
         }
+    });
     Eigen::Vector4d sum = Eigen::Vector4d::Zero();
     for (const Eigen::Vector4d& p : part) sum += p;
     impulse_ = sum.head<3>();
@@ -282,11 +282,11 @@ bool Contact::staleAfterAffineFit(std::span<const Eigen::Vector3d> x,
         return ((x[i] - builtAt_[i]) * (builtAt_[i] - builtCentre_).transpose()).eval();
     });
     const Eigen::Matrix3d g = cross * builtScatterInverse_;
-    double residual = 0.0;  // squared
-#pragma omp parallel for schedule(static) reduction(max : residual) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i)
-        residual = std::max(
-            residual, (x[i] - builtAt_[i] - mean - g * (builtAt_[i] - builtCentre_)).squaredNorm());
+    const double residual =  // squared
+        largestOverIndices(n >= kParallelThreshold, 0, n, 0.0, [&](int i, double& most) {
+            most = std::max(
+                most, (x[i] - builtAt_[i] - mean - g * (builtAt_[i] - builtCentre_)).squaredNorm());
+        });
     const Eigen::MatrixXd image = (Eigen::Matrix3d::Identity() + g) * builtSpan_;
     const double sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(image).singularValues().minCoeff();
     return sigma * (thickness_ + skin_) - 2.0 * std::sqrt(residual) < thickness_;
@@ -439,15 +439,14 @@ void Contact::buildList(const SheetState& s) {
         });
     };
     std::vector<std::vector<Candidate>> found;
-#pragma omp parallel if (n >= kParallelThreshold)
-    {
+    inTeam(n >= kParallelThreshold, [&] {
 #pragma omp single
         found.resize(std::size_t(omp_get_num_threads()));
         std::vector<Candidate>& mine = found[std::size_t(omp_get_thread_num())];
 #pragma omp for schedule(static)
         for (int i = 0; i < n; ++i)
             if (active[std::size_t(i)] == 1) candidates(i, mine);
-    }
+    });
     storeList(n, found);
     clearMovers();
     allUsual_.reset();
@@ -489,8 +488,7 @@ void Contact::storeList(int n, std::span<const std::vector<Candidate>> found) {
     for (int i = 0; i < n; ++i)
         if (listStart_[std::size_t(i) + 1] > listStart_[std::size_t(i)]) listed_.push_back(i);
     const int listed = int(listed_.size());
-#pragma omp parallel for schedule(static) if (listed >= kParallelThreshold)
-    for (int k = 0; k < listed; ++k) {
+    forEachIndex(listed >= kParallelThreshold, 0, listed, [&](int k) {
         const int i = listed_[std::size_t(k)];
         const auto first = all.begin() + listStart_[std::size_t(i)];
         const auto last = all.begin() + listStart_[std::size_t(i) + 1];
@@ -508,7 +506,7 @@ void Contact::storeList(int n, std::span<const std::vector<Candidate>> found) {
             if (double(lower) > c->distance) lower = std::nextafter(lower, 0.0f);
             listDistance_[at] = lower;
         }
-    }
+    });
 }
 
 // The force on particle i from the point of triangle `tri` with barycentric weights w: a damped
@@ -611,9 +609,10 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     pairs_ = 0;
     if (listed_.empty() && movers_.empty()) return;  // nothing within reach of anything
     const int n = int(s.x.size());
-    double fastest = 0.0;  // squared
-#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) fastest = std::max(fastest, s.v[i].squaredNorm());
+    const double fastest =  // squared
+        largestOverIndices(n >= kParallelThreshold, 0, n, 0.0, [&](int i, double& most) {
+            most = std::max(most, s.v[i].squaredNorm());
+        });
     stiffnessRate_ =
         std::max(baseStiffnessRate_, kStopping * kStopping * fastest / (thickness_ * thickness_));
     dampingRate_ = 2.0 * kContactDamping * std::sqrt(stiffnessRate_);
@@ -624,9 +623,7 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
     const std::span<const int> order = movers_.empty() ? listed_ : order_;
     const int listed = int(order.size());
     contacts_.resize(order.size());
-    std::size_t pairs = 0;
-#pragma omp parallel for schedule(static) reduction(+ : pairs) if (listed >= kParallelThreshold)
-    for (int k = 0; k < listed; ++k) {
+    const auto resolve = [&](int k, std::size_t& pairs) {
         const int i = order[std::size_t(k)];
         const PointContact& c = contacts_[std::size_t(k)] =
             movers_.empty() ? nearestContact<false>(i, s, {})
@@ -637,9 +634,16 @@ void Contact::addSelfContactForces(const SheetState& s, std::vector<Eigen::Vecto
                                                                    orderExtra_[std::size_t(k)])));
         force[std::size_t(i)] += c.pointForce;
         pairs += std::size_t(c.points);
-        if (c.triangle < 0) continue;
+        if (c.triangle < 0) return;
         force[std::size_t(i)] += c.force;
         ++pairs;
+    };
+    std::size_t pairs = 0;
+    if (wakesTeam(listed >= kParallelThreshold)) {
+#pragma omp parallel for schedule(static) reduction(+ : pairs)
+        for (int k = 0; k < listed; ++k) resolve(k, pairs);
+    } else {
+        for (int k = 0; k < listed; ++k) resolve(k, pairs);
     }
     pairs_ = pairs;
     // The triangles' shares, in particle order: the same sums for any thread count.

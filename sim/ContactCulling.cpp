@@ -232,23 +232,22 @@ int ContactCulling::mark(std::span<const Eigen::Vector3d> x, double reach,
     const std::vector<double> edge = longestEdges(x, triangles, kept);
     const Eigen::Vector3d origin = x.empty() ? Eigen::Vector3d::Zero() : x[0];
     std::vector<Moments> moments(tiles_.size());
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
-    for (int t = 0; t < tiles; ++t) {
+    forEachIndex(tiles >= kParallelThreshold / 16, 0, tiles, [&](int t) {
         Moments& m = moments[std::size_t(t)];
         for (const int i : tiles_[std::size_t(t)].particles) {
             const Eigen::Vector3d p = x[std::size_t(i)] - origin;
             m.sum += p;
             m.cross += p * rest_[std::size_t(i)].transpose();
         }
-    }
+    });
     std::vector<OwnFit> own(tiles_.size());
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
-    for (int t = 0; t < tiles; ++t)
+    forEachIndex(tiles >= kParallelThreshold / 16, 0, tiles, [&](int t) {
         own[std::size_t(t)] = ownFit(tiles_[std::size_t(t)], moments[std::size_t(t)], x);
+    });
     std::vector<std::uint8_t> tileActive(std::size_t(tiles), 0);
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
-    for (int t = 0; t < tiles; ++t)
+    forEachIndex(tiles >= kParallelThreshold / 16, 0, tiles, [&](int t) {
         tileActive[std::size_t(t)] = !smooth(tiles_[std::size_t(t)], moments, own, x, reach);
+    });
     markOverlaps(x, reach, edge, tileActive);
     // What the search lists for: the active tiles' particles (1); the triangles it lists from
     // have a corner in an active tile or one beside it (2).
@@ -395,10 +394,9 @@ void ContactCulling::markOverlaps(std::span<const Eigen::Vector3d> x, double rea
         smallCentres.push_back(centres[std::size_t(t)]);
     }
     const PointHash hash(smallCentres, 2.0 * radiusCap + reach + edgeCap);
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
-    for (int k = 0; k < int(small.size()); ++k) {
+    forEachIndex(tiles >= kParallelThreshold / 16, 0, int(small.size()), [&](int k) {
         const int t = small[std::size_t(k)];
-        if (tileActive[std::size_t(t)]) continue;
+        if (tileActive[std::size_t(t)]) return;
         const std::vector<int>& beside = tiles_[std::size_t(t)].beside;
         hash.near(centres[std::size_t(t)], [&](int item) {
             const int u = small[std::size_t(item)];
@@ -409,7 +407,7 @@ void ContactCulling::markOverlaps(std::span<const Eigen::Vector3d> x, double rea
                               centres[std::size_t(u)], radii[std::size_t(u)], gap))
                 tileActive[std::size_t(t)] = 1;
         });
-    }
+    });
     markNearBigTiles(x, reach, edgeCap, edge, big, centres, radii, tileActive);
 }
 
@@ -448,12 +446,12 @@ void ContactCulling::markNearBigTiles(std::span<const Eigen::Vector3d> x, double
         tileActive[std::size_t(b)] = 1;
     }
     const int tiles = int(tiles_.size());
-#pragma omp parallel for schedule(static) if (tiles >= kParallelThreshold / 16)
-    for (int t = 0; t < tiles; ++t)
+    forEachIndex(tiles >= kParallelThreshold / 16, 0, tiles, [&](int t) {
         for (std::size_t k = 0; !tileActive[std::size_t(t)] && k < boxes.size(); ++k)
             if (boxes[k].squaredExteriorDistance(centres[std::size_t(t)]) <
                 radii[std::size_t(t)] * radii[std::size_t(t)])
                 tileActive[std::size_t(t)] = 1;
+    });
 }
 
 }  // namespace rend::sim

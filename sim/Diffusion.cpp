@@ -146,10 +146,10 @@ void Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t> a
     const int chunks = (lastTile - firstTile + kChunk - 1) / kChunk;
     const double* now = theta.data();
     double* next = scratch_.data();
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int c = 0; c < chunks; ++c)
+    forEachIndex(n >= kParallelThreshold, 0, chunks, [&](int c) {
         diffuseTiles(tiles_, now, next, dt, firstTile + c * kChunk,
                      std::min(lastTile, firstTile + (c + 1) * kChunk));
+    });
     for (int i = first; i < std::min(last, kTile * firstTile); ++i)
         diffuseParticle(tiles_, now, next, dt, i);
     for (int i = std::max(first, kTile * lastTile); i < last; ++i)

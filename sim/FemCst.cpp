@@ -245,13 +245,12 @@ void FemCst::forces(const StepState& s, Workspace& work,
     }
     const int n = int(x.size());
     force.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = cornerOffsets_[i]; k < cornerOffsets_[i + 1]; ++k)
             sum += cornerForce[corners_[k]];
         force[i] = sum;
-    }
+    });
     static_cast<FemWorkspace&>(work).lowest = lowest;
 }
 
@@ -382,14 +381,15 @@ void FemCst::fracture(const StepState& s, Workspace&) {
     const bool breakable = std::isfinite(criticalStrain_);
     if (maxStrain_.empty() && !breakable) return;
     const int elements = int(elements_.size());
-#pragma omp parallel for schedule(static) if (elements >= kParallelThreshold)
-    for (int t = 0; t < elements; ++t) {  // each element's own history and flag
-        if (!elementAlive(t)) continue;
-        const double stretch = 1.0 + expansion_ * thetaOf(elements_[t], s.theta);
-        if (!maxStrain_.empty())
-            yieldElement(t, stretchesOf(deformationGradient(elements_[t], x) / stretch));
-        if (breakable && pastCriticalStrain(t, x, s.theta)) eroding_[t] = 1;
-    }
+    forEachIndex(elements >= kParallelThreshold, 0, elements,
+                 [&](int t) {  // each element's own history and flag
+                     if (!elementAlive(t)) return;
+                     const double stretch = 1.0 + expansion_ * thetaOf(elements_[t], s.theta);
+                     if (!maxStrain_.empty())
+                         yieldElement(t,
+                                      stretchesOf(deformationGradient(elements_[t], x) / stretch));
+                     if (breakable && pastCriticalStrain(t, x, s.theta)) eroding_[t] = 1;
+                 });
     erodeFlagged(true);
 }
 

@@ -144,22 +144,20 @@ double MassSpring::stiffestSpring(const StepState& state) const {
     const auto& v = state.v;
     const double dt = state.dt;
     const bool own = ownLaws();
-    double stiffest = 1.0;
     const int count = int(springs_.size());
-#pragma omp parallel for schedule(static) reduction(max : stiffest) if (count >= kParallelThreshold)
-    for (int s = 0; s < count; ++s) {
-        if (!springAlive(s)) continue;
+    const auto lookAhead = [&](int s, double& stiffest) {
+        if (!springAlive(s)) return;
         double thetaBar;
         const double eta = mechanicalStrain(s, state, thetaBar);
-        if (eta >= 0.0) continue;
+        if (eta >= 0.0) return;
         const Spring& sp = springs_[s];
         const Eigen::Vector3d r = x[sp.j] - x[sp.i];
         const double rate = r.dot(v[sp.j] - v[sp.i]) / (r.norm() * sp.restLength);
         const double ahead = clampCompression(eta + std::min(0.0, dt * rate));
         stiffest = std::max(
             stiffest, own ? lawOf(s).powerLawStiffening(ahead) : law_.powerLawStiffening(ahead));
-    }
-    return stiffest;
+    };
+    return largestOverIndices(count >= kParallelThreshold, 0, count, 1.0, lookAhead);
 }
 
 double MassSpring::mechanicalStrain(int s, const StepState& state, double& thetaBar) const {
@@ -174,11 +172,10 @@ void MassSpring::tensions(const StepState& state, SpringWorkspace& work) const {
     std::vector<double>& tension = work.tension;
     const int count = int(springs_.size());
     if (model_ == SpringModel::VanGelder) {
-#pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
-        for (int s = 0; s < count; ++s) {
+        forEachIndex(count >= kParallelThreshold, 0, count, [&](int s) {
             if (!springAlive(s)) {
                 tension[s] = 0.0;
-                continue;
+                return;
             }
             double thetaBar;
             const double eta = mechanicalStrain(s, state, thetaBar);
@@ -186,7 +183,7 @@ void MassSpring::tensions(const StepState& state, SpringWorkspace& work) const {
             const double k = yieldOf(s);
             tension[s] = springs_[s].k * springs_[s].restLength * k *
                          lawOf(s).force(eta / k, plastic) * material_.stiffnessFactor(thetaBar);
-        }
+        });
         return;
     }
     switch (law_.kind) {
@@ -235,12 +232,11 @@ void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& w
     std::vector<double>& tension = work.tension;
     std::vector<std::array<double, 3>>& triangleTension = work.triangleTension;
     const int triangles = int(triangles_.size());
-#pragma omp parallel for schedule(static) if (triangles >= kParallelThreshold)
-    for (int k = 0; k < triangles; ++k) {
+    forEachIndex(triangles >= kParallelThreshold, 0, triangles, [&](int k) {
         const Triangle& tri = triangles_[k];
         if (!damage_->keptTriangles()[tri.triangle]) {
             triangleTension[k] = {0.0, 0.0, 0.0};
-            continue;
+            return;
         }
         SideStrains e = sideStrains(k, state);
         // Elastoplastic: the rest triangle of sides l0 (1 + p), p the springs' permanent strains
@@ -265,7 +261,7 @@ void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& w
                 // A plastic flow that flattens the triangle leaves it nothing to carry.
                 if (!(restArea > 1e-3 * tri.restArea)) {
                     triangleTension[k] = {0.0, 0.0, 0.0};
-                    continue;
+                    return;
                 }
                 fixedPart *= tri.restArea / restArea;  // eq. 12 for the new rest triangle
                 e = sideStrains(x, tri.v, rest, restArea, e.theta);
@@ -282,21 +278,20 @@ void MassSpring::twoParameterTensions(const StepState& state, SpringWorkspace& w
         const double scale = stretch * material_.stiffnessFactor(e.theta);
         for (int s = 0; s < 3; ++s)  // eqs. 13-14 times eps_b b0
             triangleTension[k][s] = scale * fixedPart * rest[s] * (all - 2.0 * l0sq[s] * q[s]);
-    }
+    });
     std::fill(tension.begin(), tension.end(), 0.0);
     for (int k = 0; k < triangles; ++k)
         for (int s = 0; s < 3; ++s) tension[triangles_[k].side[s]] += triangleTension[k][s];
     if constexpr (K == BondLawKind::PowerLaw) {  // each spring's secant phi(eta) / eta
         const int count = int(springs_.size());
-#pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
-        for (int s = 0; s < count; ++s) {
+        forEachIndex(count >= kParallelThreshold, 0, count, [&](int s) {
             double thetaBar;
             const double eta = mechanicalStrain(s, state, thetaBar);
             // Below 1e-6 the secant is 1 to within phi''(0) 1e-6: a part in a million of a
             // tension that is itself a millionth of the stiffness.
             if (std::abs(eta) > 1e-6)
                 tension[s] *= (ownLaws() ? lawOf(s).forceAs<K>(eta) : law_.forceAs<K>(eta)) / eta;
-        }
+        });
     }
 }
 
@@ -307,8 +302,7 @@ void MassSpring::forces(const StepState& state, Workspace& work,
     const auto& x = state.x;
     const int n = int(x.size());
     force.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = springOffsets_[i]; k < springOffsets_[i + 1]; ++k) {
             const int code = particleSprings_[k];
@@ -318,7 +312,7 @@ void MassSpring::forces(const StepState& state, Workspace& work,
             sum += springs.tension[std::abs(code) - 1] / r.norm() * r;
         }
         force[i] = sum;
-    }
+    });
 }
 
 std::vector<double> MassSpring::stiffnessRowSums(int particleCount) const {

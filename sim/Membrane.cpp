@@ -178,8 +178,8 @@ void Membrane::kick(double h, double tNext) {
     const int n = particleCount();
     const Eigen::Vector3d gravity = params_.gravity;
     const double damping = params_.damping;
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = begin_; i < end_; ++i) updateVelocity(i, h, tNext, gravity, damping);
+    forEachIndex(n >= kParallelThreshold, begin_, end_,
+                 [&](int i) { updateVelocity(i, h, tNext, gravity, damping); });
 }
 
 void Membrane::checkFinite() {
@@ -214,12 +214,11 @@ void Membrane::integrate(double dt, double tNext, std::optional<bool> moved) {
     if (moved) {  // the force pass kicked and drifted them (stepSymplecticEuler)
         collide(tNext, *moved);
     } else if (solver_->carriesMomentum()) {  // MPM: the kick, the grid, then the drift
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-        for (int i = 0; i < n; ++i) updateVelocity(i, kickDt, tNext, gravity, damping);
+        forEachIndex(n >= kParallelThreshold, 0, n,
+                     [&](int i) { updateVelocity(i, kickDt, tNext, gravity, damping); });
         if (contact_ && contact_->hasColliders()) contact_->place(tNext - dt);
         solver_->transferMomentum({x_, mass_, free_, dt, contact_ ? &*contact_ : nullptr}, v_);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-        for (int i = 0; i < n; ++i) x_[i] += dt * v_[i];
+        forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) { x_[i] += dt * v_[i]; });
         collide(tNext);
     } else {
         collide(tNext, kickAndDrift(kickDt, dt, tNext));
@@ -268,14 +267,17 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
     const BlowUpGuard::State moved = motionState();
     guard_.beginMotion(begin_, end_);
-    bool below = false;
-#pragma omp parallel for schedule(static) if (end_ - begin_ >= kParallelThreshold) \
-    reduction(||                                                                   \
-              : below)
-    for (int b = 0; b < blocks; ++b) {
+    const auto move = [&](int b, bool& below) {
         below =
             kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock)) || below;
         guard_.sampleMotion(moved, b);
+    };
+    bool below = false;
+    if (wakesTeam(end_ - begin_ >= kParallelThreshold)) {
+#pragma omp parallel for schedule(static) reduction(|| : below)
+        for (int b = 0; b < blocks; ++b) move(b, below);
+    } else {
+        for (int b = 0; b < blocks; ++b) move(b, below);
     }
     guard_.endMotion();
     return floor == Contact::kNoFloor || below;
@@ -451,8 +453,7 @@ void Membrane::stepVelocityVerlet() {
     for (int k = 0; k < pieces; ++k) {
         const double h = (dt_ - done) / (pieces - k);
         kick(0.5 * h, time_ + done + h);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-        for (int i = 0; i < n; ++i) x_[i] += h * v_[i];
+        forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) { x_[i] += h * v_[i]; });
         accumulateForces();  // at x^n+1
         kick(0.5 * h, time_ + done + h);
         if (solver_->carriesMomentum())
@@ -523,8 +524,7 @@ double Membrane::failureApproachRate() const {
             stepState(), {criticalStretch_, m.expansion, m.strengthLoss, delta}))
         return domain_ ? domain_->max(*fast) : *fast;
     double fastest = 0.0;  // a maximum: the same for any thread count
-#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
-    for (int i = begin_; i < end_; ++i) {
+    const auto rateOf = [&](int i, double& fastest) {
         for (int b = bonds_.offsets[i]; b < bonds_.offsets[i + 1]; ++b) {
             const int j = bonds_.partners[b];
             if (j < i || !alive[b]) continue;  // each bond once
@@ -542,7 +542,8 @@ double Membrane::failureApproachRate() const {
             const double margin = critical - (length / rest - unstretched);
             fastest = std::max(fastest, rate / std::max(0.5 * margin, delta * critical));
         }
-    }
+    };
+    fastest = largestOverIndices(n >= kParallelThreshold, begin_, end_, fastest, rateOf);
     return domain_ ? domain_->max(fastest) : fastest;
 }
 
@@ -594,8 +595,9 @@ double Membrane::strainEnergy() const {
 double Membrane::maxSpeed() const {
     const int n = particleCount();
     double fastest = 0.0;  // squared; a maximum is the same for any thread count
-#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) fastest = std::max(fastest, v_[i].squaredNorm());
+    fastest = largestOverIndices(n >= kParallelThreshold, 0, n, fastest, [&](int i, double& most) {
+        most = std::max(most, v_[i].squaredNorm());
+    });
     return std::sqrt(fastest);
 }
 

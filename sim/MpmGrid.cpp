@@ -145,19 +145,17 @@ void MpmGrid::particleToGrid(std::span<const double> mass, std::span<const Eigen
 // over (a, b, c) are the columns, less v_p frac^T.
 void MpmGrid::nodeVelocities(const NodeCollision& collide) {
     const int nodeCount = int(nodeMass_.size());
-#pragma omp parallel for schedule(static) if (nodeCount >= kParallelThreshold)
-    for (int i = 0; i < nodeCount; ++i) {
-        if (nodeMass_[i] <= 0.0) continue;
+    forEachIndex(nodeCount >= kParallelThreshold, 0, nodeCount, [&](int i) {
+        if (nodeMass_[i] <= 0.0) return;
         nodeMomentum_[i] /= nodeMass_[i];
         if (collide) collide(h_ * nodeCell_[i].cast<double>(), nodeMomentum_[i]);
-    }
+    });
 }
 
 void MpmGrid::gridToParticle(std::span<Eigen::Vector3d> v, std::span<Eigen::Matrix3d> affine) {
     const int count = int(stencil_.size());
     const double toAffine = 4.0 / h_;
-#pragma omp parallel for schedule(static) if (count >= kParallelThreshold)
-    for (int q = 0; q < count; ++q) {
+    forEachIndex(count >= kParallelThreshold, 0, count, [&](int q) {
         const Stencil& s = stencil_[q];
         const std::array<double, 27> w = stencilWeights(s.frac);
         const int* nodes = &nodes_[27 * std::size_t(s.particle)];
@@ -172,7 +170,7 @@ void MpmGrid::gridToParticle(std::span<Eigen::Vector3d> v, std::span<Eigen::Matr
         }
         v[s.particle] = velocity;
         affine[s.particle] = toAffine * (moment - velocity * s.frac.transpose());
-    }
+    });
 }
 
 void MpmGrid::transfer(std::span<const Eigen::Vector3d> x, std::span<const double> mass,

@@ -435,8 +435,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
         if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
         return (bondScale[b] * f / length) * r;
     };
-#pragma omp parallel if (n >= kParallelThreshold)
-    {
+    inTeam(n >= kParallelThreshold, [&] {
 #pragma omp for schedule(static) reduction(max : stiffest) reduction(+ : breaking)
         for (int i = slab_.ghostBegin; i < slab_.end; ++i) {
             const Eigen::Vector3d xi = xs[i];
@@ -450,7 +449,7 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
             for (int u = pairBegin[i]; u < pairBegin[i + 1]; ++u) sum += pairForce[u];
             force[i] = sum;
         }
-    }
+    });
     updates.breaking = breaking;
     updates.stiffest = stiffest;
 }
@@ -599,8 +598,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     // before its run (read-only, before the barrier, so before any owner moves the histories
     // on). Every slot holds the bits the owner computes, and each sum is in the gather's order:
     // the same bits for any thread count. Runs and blocks start at a tile's first particle.
-#pragma omp parallel if (n >= kParallelThreshold) reduction(max : stiffest)
-    {
+    stiffest = largestInTeam(n >= kParallelThreshold, stiffest, [&](double& stiffest) {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
         const std::int64_t span = slab_.end - slab_.ghostBegin;
         const int from = tileStart(slab_.ghostBegin + int(span * t / threads));
@@ -684,7 +682,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
 #pragma omp barrier
             moveRange(*motion, std::max(from, slab_.begin), settled);
         }
-    }
+    });
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
     updates.stiffest = stiffest;
 }
@@ -775,16 +773,14 @@ std::optional<double> PeridynamicBonds::failureApproachRate(const StepState& s,
     const int n = bonds_.particleCount(), first = pairsBefore(tileStart(slab_.begin));
     const int last = pairsBefore(slab_.end);
     double fastest = 0.0;  // a maximum: the same for any thread count
-#pragma omp parallel if (n >= kParallelThreshold) reduction(max : fastest)
-    {
+    return largestInTeam(n >= kParallelThreshold, fastest, [&](double& fastest) {
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();
         const std::int64_t span = last - first;
         const int from = first + kTile * int(span / kTile * t / threads);
         const int to =
             t + 1 == threads ? last : first + kTile * int(span / kTile * (t + 1) / threads);
         fastest = std::max(fastest, pairApproachRate(in, a, from, to));
-    }
-    return fastest;
+    });
 }
 
 void PeridynamicBonds::reportStrength(DamageState& damage) const {

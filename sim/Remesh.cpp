@@ -58,12 +58,11 @@ void Remesher::remesh(std::span<Eigen::Vector3d> x, std::span<Eigen::Vector3d> v
                       std::span<const std::uint8_t> free) const {
     const int n = int(x.size());
     std::vector<Eigen::Vector3d> newX(x.begin(), x.end()), newV(v.begin(), v.end());
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
-        if (!free[i]) continue;
+    forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) {
+        if (!free[i]) return;
         newX[i] = fitted(i, x, alive);
         newV[i] = fitted(i, v, alive);
-    }
+    });
     // Hand the momentum the fit moved back evenly over the free particles, in index order.
     Eigen::Vector3d change = Eigen::Vector3d::Zero();
     double freeMass = 0.0;

@@ -202,8 +202,8 @@ void TotalLagrangianSph::deformations(const StepState& s,
                                       std::vector<Eigen::Matrix<double, 3, 2>>& deformation) const {
     const int n = int(s.x.size());
     deformation.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) deformation[i] = deformationGradient(i, s.x);
+    forEachIndex(n >= kParallelThreshold, 0, n,
+                 [&](int i) { deformation[i] = deformationGradient(i, s.x); });
 }
 
 void TotalLagrangianSph::correctGradients(int i) {
@@ -256,16 +256,14 @@ void TotalLagrangianSph::forcesFrom(const StepState& s, SphWorkspace& work,
     const int n = int(deformation.size());
     stress.resize(n);
     force.resize(n);
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) {
         // Psi(F / s) with s = 1 + alpha theta: its derivative is P(F / s) / s.
         const double stretch = 1.0 + expansion_ * thetaAt(s.theta, i);
         stress[i] = stiffnessOf(i) * volume_[i] * thickness_ *
                     material_.stiffnessFactor(thetaAt(s.theta, i)) / stretch *
                     firstPiola(i, deformation[i] / stretch);
-    }
-#pragma omp parallel for schedule(static) if (n >= kParallelThreshold)
-    for (int i = 0; i < n; ++i) {
+    });
+    forEachIndex(n >= kParallelThreshold, 0, n, [&](int i) {
         Eigen::Vector2d own = Eigen::Vector2d::Zero();
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int k = offsets_[i]; k < offsets_[i + 1]; ++k) {
@@ -273,7 +271,7 @@ void TotalLagrangianSph::forcesFrom(const StepState& s, SphWorkspace& work,
             sum -= stress[neighbours_[k]] * gradient_[mirror_[k]];  // - V_j h P_j g_ji
         }
         force[i] = sum + stress[i] * own;
-    }
+    });
 }
 
 std::vector<double> TotalLagrangianSph::stiffnessRowSums(int particleCount) const {

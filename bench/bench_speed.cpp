@@ -296,13 +296,36 @@ Paired paired(bool withLammps, Figure&& figure) {
 
 }  // namespace
 
+/// argv's whole number after `option` (all of it read, in [least, most]), or a message on
+/// stderr and false: "1e6" is a million, where atol read 1 and ran 10^4 alone.
+bool numberAfter(const char* option, const char* text, double least, double most, double& value) {
+    char* end = nullptr;
+    value = std::strtod(text, &end);
+    if (end != text && *end == '\0' && value >= least && value <= most &&
+        value == std::floor(value))
+        return true;
+    std::fprintf(stderr, "bench_speed: %s %s: expected a whole number from %g to %g\n", option,
+                 text, least, most);
+    return false;
+}
+
 int main(int argc, char** argv) {
     long largest = 10000000;
     int cpu = -1;
     bool cpuGiven = false;
-    for (int k = 1; k + 1 < argc; ++k) {
-        if (std::string(argv[k]) == "--largest") largest = std::atol(argv[k + 1]);
-        if (std::string(argv[k]) == "--cpu") cpu = std::atoi(argv[k + 1]), cpuGiven = true;
+    for (int k = 1; k < argc; k += 2) {
+        const std::string option = argv[k];
+        double value = 0.0;
+        if ((option != "--largest" && option != "--cpu") || k + 1 >= argc) {
+            std::fprintf(stderr, "bench_speed: %s: expected --largest N or --cpu K%s\n", argv[k],
+                         k + 1 >= argc ? ", with its number" : "");
+            return 2;
+        }
+        if (!numberAfter(argv[k], argv[k + 1], option == "--cpu" ? 0.0 : 1.0,
+                         option == "--cpu" ? CPU_SETSIZE - 1 : 1e9, value))
+            return 2;
+        if (option == "--largest") largest = long(value);
+        if (option == "--cpu") cpu = int(value), cpuGiven = true;
     }
     const int cores = rend::usableCores();
     const int width = rend::sim::simdWidth();

@@ -400,5 +400,16 @@ fi
 check "plot_run refuses a folder without stats" bash -c '! scripts/plot_run.py "$1" 2>"$2" && grep -q "holds no stats.csv" "$2"' _ "$tmp/empty" "$tmp/plot_err"
 check "plot_bench refuses stats.csv by name" bash -c '! scripts/plot_bench.py "$1" 2>"$2" && grep -q "draw it with scripts/plot_run.py" "$2" && ! grep -q Traceback "$2"' _ "$tmp/straight/stats.csv" "$tmp/plot_err"
 
+# bench_speed (built beside rend) refuses an argument it cannot read before it measures anything:
+# "1e6" is a million, and a number with anything after it is refused, not read as its start.
+bench="$(dirname "$rend")/bench_speed"
+if [[ -x $bench ]]; then
+    for args in "--largest 1e6x" "--largest" "--largest 0" "--cpu 1.5" "--cpu -1" "--threads 2"; do
+        check "bench_speed refuses $args" bash -c '"$1" $2 >/dev/null 2>"$3"; [[ $? -eq 2 ]] && grep -q "expected" "$3"' _ "$bench" "$args" "$tmp/bench_err"
+    done
+else
+    echo "SKIPPED: bench_speed's arguments (not built: Google Benchmark missing)"
+fi
+
 echo "$passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -389,8 +389,10 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
     // needs known, StepState::stiffeningNeeded).
     double stiffest = std::max(1.0, s.stiffeningNeeded);
     int breaking = 0;
-    // Pair u = (i, j) through its upper copy b: its force on i, or zero where it carries none.
-    auto pairForceOf = [&](int i, const Eigen::Vector3d& xi, int b, int u) -> Eigen::Vector3d {
+    // Pair u = (i, j) through its upper copy b: its force on i, or zero where it carries none;
+    // the thread's own stiffest tangent and count of breaking copies moved on.
+    auto pairForceOf = [&](int i, const Eigen::Vector3d& xi, int b, int u, double& stiffest,
+                           int& breaking) -> Eigen::Vector3d {
         if (!alive[b]) return Eigen::Vector3d::Zero();
         const int j = partners[b];
         const Eigen::Vector3d r = xs[j] - xi;
@@ -435,12 +437,22 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
         if constexpr (kTheta) f *= material_.stiffnessFactor(thetaBar);
         return (bondScale[b] * f / length) * r;
     };
+    // Each thread's maximum and count, combined once it is done (an OpenMP reduction would not
+    // reach the lambda's updates: it captured the shared variables, not the private copies).
+    const double needed = stiffest;
     inTeam(n >= kParallelThreshold, [&] {
-#pragma omp for schedule(static) reduction(max : stiffest) reduction(+ : breaking)
+        double mostHere = needed;
+        int breakingHere = 0;
+#pragma omp for schedule(static)
         for (int i = slab_.ghostBegin; i < slab_.end; ++i) {
             const Eigen::Vector3d xi = xs[i];
             for (int b = upperBegin[i], u = pairBegin[i]; b < offsets[i + 1]; ++b, ++u)
-                pairForce[u] = pairForceOf(i, xi, b, u);
+                pairForce[u] = pairForceOf(i, xi, b, u, mostHere, breakingHere);
+        }
+#pragma omp critical(rend_scalar_pair_pass)
+        {
+            stiffest = std::max(stiffest, mostHere);
+            breaking += breakingHere;
         }
 #pragma omp for schedule(static)
         for (int i = slab_.begin; i < slab_.end; ++i) {

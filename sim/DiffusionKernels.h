@@ -29,6 +29,9 @@ struct DiffusionTiles {
     std::vector<double> classRate, classUnit;
     std::vector<std::uint16_t> rateSteps;
     static constexpr int kSteppedRate = -2;
+    /// Per tile: 1 where it has kTile rows, each a run with one rate (a regular lattice's
+    /// interior), whose sums are straight code.
+    std::vector<std::uint8_t> plainTile;
     /// Per row, bit l: slot kTile row + l's bond lives (refresh()); 0 for a pad.
     std::vector<std::uint8_t> livingRows;
     std::uint64_t livingVersion = ~std::uint64_t(0);

@@ -106,6 +106,18 @@ TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
     if (rates == Rates::Random) EXPECT_EQ(tiles.classedRows(), 0);
     if (rates != Rates::Random) EXPECT_GT(tiles.classedRows(), allRows * 3 / 4);
     if (rates == Rates::Stepped) EXPECT_GT(stepped, allRows / 2);
+    // Tiles of eight runs with one rate each sum as straight code (plainTile): never where each
+    // rate is its own (PlainTilesSumAsTheLoopDoes below takes that path).
+    const int tileCount = int(tiles.tileBegin.size()) - 1;
+    ASSERT_EQ(int(tiles.plainTile.size()), tileCount);
+    if (rates == Rates::Random)
+        EXPECT_EQ(std::count(tiles.plainTile.begin(), tiles.plainTile.end(), 1), 0);
+    for (int t = 0; t < tileCount; ++t)
+        if (tiles.plainTile[t]) {
+            EXPECT_EQ(tiles.tileBegin[t + 1] - tiles.tileBegin[t], kTile * kTile);
+            for (int row = tiles.tileBegin[t] / kTile; row < tiles.tileBegin[t + 1] / kTile; ++row)
+                EXPECT_TRUE(tiles.rowRun[row] >= 0 && tiles.rowClass[row] >= 0) << row;
+        }
     // On the square sheet, away from its first and last two rows, every row of a tile is a run
     // of consecutive partners, the tiles across a lattice row's end too (a row per offset): no
     // row gathers its theta.
@@ -128,6 +140,47 @@ INSTANTIATE_TEST_SUITE_P(
     Lattices, DiffusionTileSums,
     ::testing::Combine(::testing::Values(LatticeKind::Hexagonal, LatticeKind::Square),
                        ::testing::Values(Rates::Random, Rates::Lattice, Rates::Stepped)));
+
+// The square sheet's own rates (one exact value per direction) make most tiles plain: eight
+// runs with one rate each, summed as straight code with the rows' living bytes read as one
+// word. With some bonds dead, and tiles with all of them living, the sums keep the loop's bits.
+TEST(DiffusionTiles, PlainTilesSumAsTheLoopDoes) {
+    const Sheet sheet(LatticeKind::Square);
+    const BondFamilies& bonds = sheet.bonds;
+    const int n = bonds.particleCount();
+    const Diffusion diffusion(sheet.params, sheet.lattice.positions, bonds, sheet.volumes);
+    DiffusionTiles tiles = diffusion.tiles();
+    std::vector<double> rate(bonds.directedCount(), 0.0);
+    for (std::size_t u = 0; u < tiles.bond.size(); ++u)
+        if (tiles.bond[u] >= 0) rate[tiles.bond[u]] = tiles.rate[u];
+    std::vector<std::uint8_t> alive(bonds.directedCount(), 1);
+    for (int b = 0; b < bonds.offsets[n / 2]; b += 11) alive[b] = 0;  // the first half's
+    tiles.refresh(alive.data(), 1);
+    std::vector<double> theta(n);
+    for (int i = 0; i < n; ++i) theta[i] = 40.0 * (uniformFromHash(5, i) - 0.5);
+    const double dt = 1e-3;
+    constexpr int kTile = DiffusionTiles::kTile;
+    const int whole = n / kTile;
+    std::vector<double> next(n, -1.0);
+    diffuseTiles(tiles, theta.data(), next.data(), dt, 0, whole);
+    for (int i = kTile * whole; i < n; ++i)
+        diffuseParticle(tiles, theta.data(), next.data(), dt, i);
+    const std::vector<double> expected = naiveStep(bonds, rate, alive, theta, dt);
+    EXPECT_EQ(std::memcmp(next.data(), expected.data(), n * sizeof(double)), 0);
+    int plain = 0, plainWithDead = 0;
+    for (int t = 0; t < whole; ++t) {
+        if (!tiles.plainTile[t]) continue;
+        ++plain;
+        for (int row = tiles.tileBegin[t] / kTile; row < tiles.tileBegin[t + 1] / kTile; ++row)
+            if (tiles.livingRows[row] != 0xff) {
+                ++plainWithDead;
+                break;
+            }
+    }
+    EXPECT_GT(plain, whole / 2) << "of " << whole;
+    EXPECT_GT(plainWithDead, 0);
+    EXPECT_LT(plainWithDead, plain);
+}
 
 // A diffusion that stepped before some bonds broke steps afterwards as one built on the broken
 // bonds does: its copy of which bonds live follows DamageState::version().

@@ -207,6 +207,39 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     }
 }
 
+// A plain tile (DiffusionTiles::plainTile) in two halves of four lanes: its rows' runs as
+// plain loads, each row's rate from its class once for both; the same terms in the same order as
+// the loop below, which reads each slot's partner and rate (REND_SIMD=avx2, the diffusion alone,
+// crack_path_sources, linear, pinned: 2.66 -> 1.52 ns per particle-step at 10^4, 5.27 -> 1.66
+// at 10^6).
+[[gnu::target("avx2")]] inline void diffusePlainTile(const DiffusionTiles& d, const double* theta,
+                                                     double* next, __m256d step, __m256i laneBit,
+                                                     int t) {
+    const __m256d ownLow = _mm256_loadu_pd(theta + 8 * t);
+    const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
+    __m256d low = _mm256_setzero_pd(), high = low;
+    const int first = d.tileBegin[t] / 8;
+#pragma GCC unroll 8
+    for (int k = 0; k < 8; ++k) {
+        const int row = first + k, lives = d.livingRows[row];
+        const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
+        const double* other = theta + d.rowRun[row];
+        const __m256i bitsLow = _mm256_set1_epi64x(lives),
+                      bitsHigh = _mm256_set1_epi64x(lives >> 4);
+        const __m256d aliveLow =
+            _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bitsLow, laneBit), laneBit));
+        const __m256d aliveHigh =
+            _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bitsHigh, laneBit), laneBit));
+        const __m256d termLow = _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other), ownLow));
+        const __m256d termHigh =
+            _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other + 4), ownHigh));
+        low = _mm256_blendv_pd(low, _mm256_add_pd(low, termLow), aliveLow);
+        high = _mm256_blendv_pd(high, _mm256_add_pd(high, termHigh), aliveHigh);
+    }
+    _mm256_storeu_pd(next + 8 * t, _mm256_add_pd(ownLow, _mm256_mul_pd(step, low)));
+    _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
+}
+
 [[gnu::target("avx2")]] void diffuseTilesAvx2(const DiffusionTiles& d, const double* theta,
                                               double* next, double dt, int firstTile,
                                               int lastTile) {
@@ -216,7 +249,11 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     const std::uint8_t* __restrict living = d.livingRows.data();
     const __m256d step = _mm256_set1_pd(dt);
     const __m256i laneBit = _mm256_setr_epi64x(1, 2, 4, 8);
-    for (int t = firstTile; t < lastTile; ++t)
+    for (int t = firstTile; t < lastTile; ++t) {
+        if (d.plainTile[t]) {
+            diffusePlainTile(d, theta, next, step, laneBit, t);
+            continue;
+        }
         for (int half = 0; half < 8; half += 4) {
             const __m256d own = _mm256_loadu_pd(theta + 8 * t + half);
             __m256d flux = _mm256_setzero_pd();
@@ -232,6 +269,7 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
             }
             _mm256_storeu_pd(next + 8 * t + half, _mm256_add_pd(own, _mm256_mul_pd(step, flux)));
         }
+    }
 }
 #endif
 

@@ -372,9 +372,9 @@ namespace {
 // blocks, so the same bits.
 class KickInPass final : public BlockMotion {
 public:
-    KickInPass(const KickDrift& kick, BlowUpGuard& guard, const BlowUpGuard::State& state,
-               int first, int last)
-        : kick_(kick), guard_(guard), state_(state), first_(first) {
+    KickInPass(const KickDrift& kick, double* forceArray, BlowUpGuard& guard,
+               const BlowUpGuard::State& state, int first, int last)
+        : kick_(kick), forceArray_(forceArray), guard_(guard), state_(state), first_(first) {
         constexpr int kBlock = BlowUpGuard::kBlock;
         const int blocks = (last - first + kBlock - 1) / kBlock;
         left_ = std::make_unique<std::atomic<int>[]>(std::size_t(blocks));
@@ -382,8 +382,10 @@ public:
             left_[b].store(std::min(last, first + (b + 1) * kBlock) - (first + b * kBlock));
         guard_.beginMotion(first, last);
     }
-    void move(int begin, int end) override {
-        if (kickDrift(kick_, begin, end)) below_.store(true, std::memory_order_relaxed);
+    void move(int begin, int end, const double* block, int first) override {
+        KickDrift k = kick_;
+        if (block) k.force = block, k.forceFirst = first, k.keptForce = forceArray_;
+        if (kickDrift(k, begin, end)) below_.store(true, std::memory_order_relaxed);
         moved_.fetch_add(end - begin, std::memory_order_relaxed);
         constexpr int kBlock = BlowUpGuard::kBlock;
         for (int b = (begin - first_) / kBlock; first_ + b * kBlock < end; ++b) {
@@ -399,6 +401,7 @@ public:
 
 private:
     KickDrift kick_;
+    double* forceArray_;
     BlowUpGuard& guard_;
     BlowUpGuard::State state_;
     int first_;
@@ -422,8 +425,8 @@ void Membrane::stepSymplecticEuler() {
     std::vector<double> prescribed;
     std::optional<KickInPass> inPass;
     if (mayKickInPass())
-        inPass.emplace(kickDriftOf(kickBefore(dt_), dt_, time_ + dt_, prescribed), guard_,
-                       motionState(), begin_, end_);
+        inPass.emplace(kickDriftOf(kickBefore(dt_), dt_, time_ + dt_, prescribed),
+                       force_.data()->data(), guard_, motionState(), begin_, end_);
     accumulateForces(inPass ? &*inPass : nullptr);  // at x^n
     const int pieces = piecesOfStep();
     keptKickInPass_ = inPass && inPass->moved() > 0;

@@ -97,6 +97,9 @@ public:
     void setKickInPass(bool on) { kickInPass_ = on; }
     /// Whether the last step's particles moved inside the force pass.
     bool keptKickInPass() const { return keptKickInPass_; }
+    /// The blow-up guard's energy budget so far [J]: the start's energy and the work the
+    /// boundaries (|force . v| on the driven particles), gravity and the rest did since.
+    double energyBudget() const { return guard_.budget(); }
 
     /// Adaptive stepping (time.dt = "adaptive", sim/TimeStep.h): steps until time() is exactly
     /// tEnd, each step from the controller, the last ones evened out to land on tEnd.

@@ -163,7 +163,8 @@ void gatherParticle(const PairGather& g, int i) {
     for (int b = g.upperBegin[i]; b < g.offsets[i + 1]; ++b)
         if (g.alive[b])
             for (int k = 0; k < 3; ++k) sum[k] += slotOf(g, b)[stride * k];
-    for (int k = 0; k < 3; ++k) g.force[3 * i + k] = sum[k];
+    double* force = g.forceOf(i);
+    for (int k = 0; k < 3; ++k) force[k] = sum[k];
 }
 
 void gatherLoop(const PairGather& g, int begin, int end) {
@@ -352,7 +353,7 @@ template <int kBonds, bool kRegular>
             z = _mm512_mask_add_pd(z, on, z, fz);
         }
     }
-    storeParticles(g.force + 3 * kTile * std::size_t(t), x, y, z, stream);
+    storeParticles(g.forceOf(kTile * t), x, y, z, stream);
 }
 
 /// The sums of tile t's eight particles: each lane's terms in its own bond order, group by
@@ -362,7 +363,7 @@ template <int kBonds, bool kRegular>
         if (one.lower == PairSumTiles::kUnion) return sumUnionTile(g, s, one, t, stream);
         const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
         const std::uint8_t* alive = g.alive + g.offsets[kTile * t];
-        double* out = g.force + 3 * kTile * std::size_t(t);
+        double* out = g.forceOf(kTile * t);
         switch (one.bonds + (one.regular ? 100 : 0)) {  // the square lattice's 8, hexagonal's 6
             case 108:
                 return sumWholeTile<8, true>(g, rows, one.lower, alive, out, stream);
@@ -394,7 +395,7 @@ template <int kBonds, bool kRegular>
             addRow(g, s, group.rowFirst + k, first, __mmask8(mask), life.of(k) << first, false,
                    sum);
     }
-    storeParticles(g.force + 3 * kTile * std::size_t(t), sum.x, sum.y, sum.z, stream);
+    storeParticles(g.forceOf(kTile * t), sum.x, sum.y, sum.z, stream);
     for (; alone != 0; alone &= alone - 1) gatherParticle(g, kTile * t + std::countr_zero(alone));
 }
 
@@ -437,7 +438,6 @@ template <int kBonds, bool kRegular>
     const std::uint8_t* __restrict alive = g.alive;
     const double* __restrict pairForce = g.pairForce;
     const unsigned mask = g.slotMask;
-    double* __restrict force = g.force;
     for (int i = begin; i < end; ++i) {
         __m256d sum = _mm256_setzero_pd();
         for (int b = offsets[i]; b < upperBegin[i]; ++b)
@@ -450,7 +450,8 @@ template <int kBonds, bool kRegular>
                                     _mm256_loadu_pd(pairForce + 4 * (unsigned(pairOf[b]) & mask)));
         double lanes[4];
         _mm256_storeu_pd(lanes, sum);
-        force[3 * i] = lanes[0], force[3 * i + 1] = lanes[1], force[3 * i + 2] = lanes[2];
+        double* __restrict force = g.forceOf(i);
+        force[0] = lanes[0], force[1] = lanes[1], force[2] = lanes[2];
     }
 }
 #endif

@@ -9,6 +9,7 @@
 // in at most three runs. Each lane adds the same terms in the same order as one particle's
 // loop, skipping the dead bonds (and the bonds it does not have) by a mask: the same bits.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -70,7 +71,9 @@ struct PairGather {
     /// rows, x at pairOf, y and z `stride` and twice that after, with kPairTile readable
     /// doubles before each and after (read, never summed).
     const double* pairForce = nullptr;
-    double* force = nullptr;              ///< x y z per particle
+    /// x y z per particle from particle forceFirst (a fused block's own), or from 0 (the whole
+    /// force array).
+    double* force = nullptr;
     unsigned slotMask = ~0u;              ///< a ring of 2^k slots, or all bits: slot u is pair u
     const PairSumTiles* tiles = nullptr;  ///< null: one particle at a time
     bool rows = false;                    ///< the slots are in rows (slotRows())
@@ -78,6 +81,9 @@ struct PairGather {
     /// lines (writesAround()).
     bool stream = false;
     int stride = 8;  ///< in rows: from a slot's x to its y
+    int forceFirst = 0;
+    /// Particle i's x y z.
+    double* forceOf(int i) const { return force + 3 * (std::ptrdiff_t(i) - forceFirst); }
 };
 
 /// Particles [begin, end).

@@ -117,6 +117,7 @@ private:
         std::vector<Eigen::Vector3d> pairForce;
         std::vector<double> slots;       ///< the vectorised laws': a ring of slots per thread
         std::vector<std::uint8_t> over;  ///< a bit per pair (LinearPairOutput::over)
+        std::vector<double> blockForce;  ///< a fused block's forces per thread, where it moves them
     };
     /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
     LinearPairInput pairInput(const StepState& s, bool update, bool breakable) const;

@@ -41,8 +41,10 @@ public:
     virtual ~BlockMotion() = default;
     /// Moves particles [begin, end) by their forces. A solver that calls it calls it once for
     /// each particle it owns, from any of its threads, after which it reads none of their
-    /// positions or velocities again in that advance().
-    virtual void move(int begin, int end) = 0;
+    /// positions or velocities again in that advance(). `block`, where not null, holds the
+    /// forces of particles [first, end) (particle i's x y z from block[3 (i - first)]), which
+    /// the solver kept there rather than in advance()'s force array; else they are in it.
+    virtual void move(int begin, int end, const double* block, int first) = 0;
 };
 
 /// One step's state, passed explicitly.

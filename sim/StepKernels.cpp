@@ -26,12 +26,14 @@ inline double massOf(const Input& in, int i) {
 inline bool kickDriftOne(const KickDrift& k, int i) {
     double* v = k.v + 3 * i;
     const std::int16_t c = k.constraint[i];
+    const double* f = k.forceOf(i);
     if (c == kFree) {
-        const double* f = k.force + 3 * i;
         const double mass = massOf(k, i);
         for (int a = 0; a < 3; ++a) v[a] += k.h * (f[a] / mass + k.gravity[a] - k.damping * v[a]);
     } else {
         for (int a = 0; a < 3; ++a) v[a] = c < 0 ? 0.0 : k.boundaryVelocity[3 * c + a];
+        if (k.keptForce)
+            for (int a = 0; a < 3; ++a) k.keptForce[3 * i + a] = f[a];
     }
     for (int a = 0; a < 3; ++a) k.x[3 * i + a] += k.dt * v[a];
     return c == kFree && !(k.x[3 * i + 2] >= k.floor);
@@ -123,7 +125,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
         for (int lane = 0; lane < 3; ++lane) {
             double* v = k.v + 3 * i + 4 * lane;
             double* x = k.x + 3 * i + 4 * lane;
-            const __m256d f = _mm256_loadu_pd(k.force + 3 * i + 4 * lane);
+            const __m256d f = _mm256_loadu_pd(k.forceOf(i) + 4 * lane);
             __m256d vel = _mm256_loadu_pd(v);
             const __m256d acceleration =
                 _mm256_sub_pd(_mm256_add_pd(_mm256_div_pd(f, mass[lane]), gravity[lane]),
@@ -170,7 +172,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             double* x = k.x + 3 * i + 8 * lane;
             const __m512d mass = one ? oneMass : _mm512_permutexvar_pd(particle[lane], masses);
             const __m512d gravity = _mm512_permutexvar_pd(axis[lane], g);
-            const __m512d f = _mm512_loadu_pd(k.force + 3 * i + 8 * lane);
+            const __m512d f = _mm512_loadu_pd(k.forceOf(i) + 8 * lane);
             __m512d vel = _mm512_loadu_pd(v);
             const __m512d acceleration = _mm512_sub_pd(
                 _mm512_add_pd(_mm512_div_pd(f, mass), gravity), _mm512_mul_pd(damping, vel));

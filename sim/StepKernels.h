@@ -5,6 +5,7 @@
 // same. The pass also tells whether any free particle ended up not above a floor, so that a
 // scene whose only collider is the ground skips the contact pass on the steps nothing touches.
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -14,7 +15,7 @@ namespace rend::sim {
 struct KickDrift {
     double* x = nullptr;  ///< x y z per particle
     double* v = nullptr;
-    const double* force = nullptr;
+    const double* force = nullptr;  ///< x y z per particle from particle forceFirst (below)
     const double* mass = nullptr;
     /// -1 free, -2 pinned, k >= 0 driven by boundary k (Membrane's tags).
     const std::int16_t* constraint = nullptr;
@@ -28,6 +29,14 @@ struct KickDrift {
     /// Where every particle has the same mass (Membrane::oneMass()), that mass, and `mass` is
     /// not read (a sheet past the caches streams 8 bytes a particle less); 0: per particle.
     double oneMass = 0.0;
+    /// Where `force` is the whole force array, 0. Where it is a block a solver kept the forces
+    /// of particles from forceFirst in (BlockMotion::move), keptForce is the force array, and
+    /// the particles that are not free have theirs copied into it (the blow-up guard reads a
+    /// driven particle's).
+    int forceFirst = 0;
+    double* keptForce = nullptr;
+    /// Particle i's force.
+    const double* forceOf(int i) const { return force + 3 * (std::ptrdiff_t(i) - forceFirst); }
 };
 
 /// Particles [begin, end): v += h (f / m + g - damping v) for the free ones, the pinned at rest,

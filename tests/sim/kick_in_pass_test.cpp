@@ -51,6 +51,7 @@ struct Steps {
     std::vector<std::uint8_t> alive;
     bool keptInPass = true;  ///< every step's
     std::size_t broken = 0;
+    double budget = 0.0;  ///< the blow-up guard's: the driven particles' forces times velocities
 };
 
 Steps stepped(const MembraneParams& p, bool inPass, int threads, int steps) {
@@ -65,6 +66,7 @@ Steps stepped(const MembraneParams& p, bool inPass, int threads, int steps) {
     r.x = m.positions(), r.v = m.velocities(), r.theta = m.theta();
     r.alive = m.damageState().bondAlive();
     r.broken = m.damageState().brokenBondCount();
+    r.budget = m.energyBudget();
     return r;
 }
 
@@ -78,6 +80,8 @@ void expectSameBits(const Steps& a, const Steps& b, const std::string& what) {
     EXPECT_TRUE(sameBits(a.v, b.v)) << what << ": velocities";
     EXPECT_TRUE(sameBits(a.theta, b.theta)) << what << ": theta";
     EXPECT_TRUE(sameBits(a.alive, b.alive)) << what << ": bonds";
+    EXPECT_EQ(std::memcmp(&a.budget, &b.budget, sizeof a.budget), 0)
+        << what << ": the guard's budget " << a.budget << " against " << b.budget;
 }
 
 }  // namespace

@@ -105,6 +105,37 @@ TEST(KickDrift, OneMassGivesTheBitsOfEveryParticleHavingIt) {
     EXPECT_FALSE(sameBits(one.v, start.v)) << "the kick moved them";
 }
 
+// Forces from a block of their own (KickDrift::forceFirst, where a solver's pass kept a block's
+// forces): the bits of the whole array's, and the particles that are not free have theirs
+// copied into the array (keptForce), the free ones' left as they were.
+TEST(KickDrift, ABlocksForcesGiveTheBitsOfTheWholeArray) {
+    const Particles start = someParticles(203);
+    const std::vector<double> boundary = {0.5, 0.0, -0.25, 0.0, 1e-3, 2.0};
+    Particles whole = start;
+    KickDrift k = viewOf(whole, boundary, 1.3e-4, 1.1e-4);
+    k.damping = 0.7, k.gravity[2] = -9.81;
+    kickDrift(k, 0, int(whole.x.size()));
+    Particles blocked = start;
+    const Eigen::Vector3d stale(7.0, -7.0, 7.0);
+    std::vector<Eigen::Vector3d> array(start.force.size(), stale);
+    KickDrift b = viewOf(blocked, boundary, 1.3e-4, 1.1e-4);
+    b.damping = 0.7, b.gravity[2] = -9.81, b.keptForce = array.data()->data();
+    for (const auto& [first, end] : {std::pair{0, 40}, {40, 45}, {45, 160}, {160, 203}}) {
+        std::vector<Eigen::Vector3d> block(start.force.begin() + first, start.force.begin() + end);
+        b.force = block.data()->data(), b.forceFirst = first;
+        kickDrift(b, first, end);
+    }
+    EXPECT_TRUE(sameBits(blocked.v, whole.v));
+    EXPECT_TRUE(sameBits(blocked.x, whole.x));
+    int copied = 0;
+    for (std::size_t i = 0; i < array.size(); ++i) {
+        const bool free = start.constraint[i] == -1;
+        EXPECT_EQ(array[i], free ? stale : start.force[i]) << "particle " << i;
+        copied += !free;
+    }
+    EXPECT_GT(copied, 5);
+}
+
 // The floor test counts exactly the free particles whose new z is not >= the floor, whichever
 // block of four or eight they sit in; pinned and driven ones never count, and NaN does.
 TEST(KickDrift, FindsAFreeParticleThatEndsBelowTheFloor) {

@@ -27,13 +27,25 @@ constexpr std::size_t kAlignedFrom = 4096;
 constexpr std::size_t kLine = 64;
 constexpr std::size_t kHugePage = std::size_t(2) << 20, kHugeFrom = std::size_t(4) << 20;
 
+// Asks for huge pages over [p, p + bytes), whole 2 MiB pages. A block malloc carves from memory
+// it has used before (the set-up's freed maps and lists: 2.2 of a 10^7 sheet's 11 GB) already
+// has small pages, which the hint alone leaves small: they are given back first (a new block's
+// contents are undefined, so nothing is lost), and the next touch faults in huge ones
+// (crack_path_sources, 10^7 particles, linear, one thread: 19.3 -> 16.1 and 20.0 -> 14.4 ns per
+// particle-step; 10^6: 13.6 -> 13.3). Hints only: where the system refuses, the pages stay as
+// they were.
+void giveHugePages(void* p, std::size_t bytes) {
+    madvise(p, bytes, MADV_HUGEPAGE);
+    madvise(p, bytes, MADV_DONTNEED);
+}
+
 }  // namespace
 
 void* operator new(std::size_t bytes) {
     void* p = nullptr;
     if (bytes >= kHugeFrom) {
         if (posix_memalign(&p, kHugePage, bytes) != 0) throw std::bad_alloc();
-        madvise(p, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);  // a hint: failure is fine
+        giveHugePages(p, bytes / kHugePage * kHugePage);
         return p;
     }
     if (bytes >= kAlignedFrom) {

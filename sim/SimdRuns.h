@@ -1,7 +1,7 @@
 #pragma once
 // Eight consecutive particles' x, y and z (24 doubles, x0 y0 z0 x1 ... z7) as three AVX-512
-// vectors: three loads, six permutes. For the kernels compiled for AVX-512 (sim/PairKernels.cpp,
-// sim/StepKernels.cpp); include it only there.
+// vectors: three loads, six permutes; four as three AVX2 vectors. For the kernels compiled for
+// AVX2 and AVX-512 (sim/PairKernels.cpp, sim/StepKernels.cpp); include it only there.
 
 #include <immintrin.h>
 
@@ -23,6 +23,18 @@ namespace rend::sim {
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14));
     z = pickLanes(pickLanes(a, b, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0)), c,
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
+}
+
+[[gnu::always_inline, gnu::target("avx2")]] inline void loadRun4(const double* p, __m256d& x,
+                                                                 __m256d& y, __m256d& z) {
+    const __m256d a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
+    // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+    x = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0100), c, 0b0010),
+                              _MM_SHUFFLE(1, 2, 3, 0));
+    y = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b1001), c, 0b0100),
+                              _MM_SHUFFLE(2, 3, 0, 1));
+    z = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0010), c, 0b1001),
+                              _MM_SHUFFLE(3, 0, 1, 2));
 }
 
 }  // namespace rend::sim

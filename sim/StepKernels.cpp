@@ -112,16 +112,22 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
                                 _mm256_setr_pd(g[1], g[2], g[0], g[1]),
                                 _mm256_setr_pd(g[2], g[0], g[1], g[2])};
     constexpr int kZLanes[3] = {0b0100, 0b0010, 0b1001};  // where the z's sit
+    // One mass for the sheet: one broadcast, the mass array unread (kickDriftAvx512's).
+    const bool one = k.oneMass > 0.0;
+    const __m256d oneMass = _mm256_set1_pd(k.oneMass);
     int i = begin;
     for (; i + 4 <= end; i += 4) {
         if (!allFree(k.constraint + i, 4)) {
             for (int p = i; p < i + 4; ++p) below |= kickDriftOne(k, p);
             continue;
         }
-        const double m[4] = {massOf(k, i), massOf(k, i + 1), massOf(k, i + 2), massOf(k, i + 3)};
-        const __m256d mass[3] = {_mm256_setr_pd(m[0], m[0], m[0], m[1]),
-                                 _mm256_setr_pd(m[1], m[1], m[2], m[2]),
-                                 _mm256_setr_pd(m[2], m[3], m[3], m[3])};
+        __m256d mass[3] = {oneMass, oneMass, oneMass};
+        if (!one) {
+            const double* m = k.mass + i;
+            mass[0] = _mm256_setr_pd(m[0], m[0], m[0], m[1]);
+            mass[1] = _mm256_setr_pd(m[1], m[1], m[2], m[2]);
+            mass[2] = _mm256_setr_pd(m[2], m[3], m[3], m[3]);
+        }
         for (int lane = 0; lane < 3; ++lane) {
             double* v = k.v + 3 * i + 4 * lane;
             double* x = k.x + 3 * i + 4 * lane;
@@ -184,6 +190,92 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
         }
     }
     return i;
+}
+
+// Four particles at a time, lane k the scalar loop's chain k (guardScalar's): the same bits.
+// A quad with a particle that is not free is visited one by one into the same chains. The
+// scalar loop had 0.12 of a step's cpu-clock samples on one Zen 3 core (crack_path_sources at
+// 10^4, linear law), this one 0.05.
+[[gnu::target("avx2")]] GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
+    GuardSums s;
+    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(g.limitSquared);
+    const __m256d gx = _mm256_set1_pd(g.gravity[0]), gy = _mm256_set1_pd(g.gravity[1]);
+    const __m256d gz = _mm256_set1_pd(g.gravity[2]), sign = _mm256_set1_pd(-0.0);
+    const __m256d iota = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+    __m256d kinetic = _mm256_setzero_pd(), gravityPower = _mm256_setzero_pd();
+    __m256d best = _mm256_setzero_pd(), bestAt = _mm256_set1_pd(-1.0);  // indices, exact
+    GuardPart p[4];
+    const bool one = g.oneMass > 0.0;
+    const __m256d oneMass = _mm256_set1_pd(g.oneMass);
+    int i = begin;
+    for (; i + 4 <= end; i += 4) {
+        if (!allFree(g.constraint + i, 4)) {
+            double k[4], w[4];
+            _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
+            for (int l = 0; l < 4; ++l) {
+                p[l].kinetic = k[l], p[l].gravityPower = w[l];
+                guardVisit(g, i + l, p[l], s);
+            }
+            kinetic = _mm256_setr_pd(p[0].kinetic, p[1].kinetic, p[2].kinetic, p[3].kinetic);
+            gravityPower = _mm256_setr_pd(p[0].gravityPower, p[1].gravityPower, p[2].gravityPower,
+                                          p[3].gravityPower);
+            continue;
+        }
+        __m256d vx, vy, vz;
+        loadRun4(g.v + 3 * std::size_t(i), vx, vy, vz);
+        const __m256d ss = _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(vx, vx), _mm256_mul_pd(vy, vy)), _mm256_mul_pd(vz, vz));
+        const int bad = _mm256_movemask_pd(_mm256_cmp_pd(ss, limit, _CMP_NLE_UQ));
+        if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(unsigned(bad));
+        const __m256d m = one ? oneMass : _mm256_loadu_pd(g.mass + i);
+        kinetic = _mm256_add_pd(kinetic, _mm256_mul_pd(_mm256_mul_pd(half, m), ss));
+        if (g.hasGravity) {
+            const __m256d along = _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(gx, vx), _mm256_mul_pd(gy, vy)), _mm256_mul_pd(gz, vz));
+            gravityPower =
+                _mm256_add_pd(gravityPower, _mm256_mul_pd(m, _mm256_andnot_pd(sign, along)));
+        }
+        const __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
+        best = _mm256_blendv_pd(best, ss, faster);
+        bestAt = _mm256_blendv_pd(bestAt, _mm256_add_pd(_mm256_set1_pd(double(i)), iota), faster);
+    }
+    double k[4], w[4], speeds[4], at[4];
+    _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
+    _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(at, bestAt);
+    for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
+    for (; i < end; ++i) guardVisit(g, i, p[0], s);
+    const auto total = [&](double GuardPart::*field) {
+        return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
+    };
+    s.kinetic = total(&GuardPart::kinetic);
+    s.boundaryPower = total(&GuardPart::boundaryPower);
+    s.gravityPower = total(&GuardPart::gravityPower);
+    for (int l = 0; l < 4; ++l) {
+        const bool higher = speeds[l] > s.maxSpeedSquared;
+        const bool tie = speeds[l] == s.maxSpeedSquared && int(at[l]) < s.fastest;
+        if (at[l] >= 0.0 && (higher || tie)) s.maxSpeedSquared = speeds[l], s.fastest = int(at[l]);
+    }
+    return s;
+}
+
+// Four at a time; NaN and inf are bad (not <= the largest double), a NaN lane keeps the max.
+[[gnu::target("avx2")]] GuardSums guardThetaAvx2(const double* theta, int begin, int end) {
+    GuardSums s;
+    const __m256d finite = _mm256_set1_pd(std::numeric_limits<double>::max());
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    __m256d largest = _mm256_setzero_pd();
+    int i = begin;
+    for (; i + 4 <= end; i += 4) {
+        const __m256d a = _mm256_andnot_pd(sign, _mm256_loadu_pd(theta + i));
+        const int bad = _mm256_movemask_pd(_mm256_cmp_pd(a, finite, _CMP_NLE_UQ));
+        if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(unsigned(bad));
+        largest = _mm256_max_pd(a, largest);
+    }
+    for (; i < end; ++i) guardVisitTheta(theta, i, s);
+    double lanes[4];
+    _mm256_storeu_pd(lanes, largest);
+    for (const double l : lanes) s.maxAbsTheta = std::max(s.maxAbsTheta, l);
+    return s;
 }
 
 /// Eight lanes' sums, added pairwise in lane order.
@@ -275,6 +367,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 GuardSums guardMotionSums(const GuardInput& g, int begin, int end) {
 #if defined(__x86_64__)
     if (simdWidth() == 8) return guardAvx512(g, begin, end);
+    if (simdWidth() == 4) return guardAvx2(g, begin, end);
 #endif
     return guardScalar(g, begin, end);
 }
@@ -282,6 +375,7 @@ GuardSums guardMotionSums(const GuardInput& g, int begin, int end) {
 GuardSums guardThetaSums(const double* theta, int begin, int end) {
 #if defined(__x86_64__)
     if (simdWidth() == 8) return guardThetaAvx512(theta, begin, end);
+    if (simdWidth() == 4) return guardThetaAvx2(theta, begin, end);
 #endif
     return guardThetaScalar(theta, begin, end);
 }

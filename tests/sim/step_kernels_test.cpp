@@ -223,6 +223,56 @@ TEST(GuardSums, MatchTheSumsOneParticleAtATime) {
     }
 }
 
+/// The scalar loop's sums: four chains, particle begin + 4 q + k in chain k, the tail in chain
+/// 0, the chains added (0 + 1) + (2 + 3).
+GuardSums fourChainGuard(const GuardInput& g, int begin, int end) {
+    double kinetic[4] = {}, gravity[4] = {}, boundary[4] = {};
+    const int whole = begin + (end - begin) / 4 * 4;
+    for (int i = begin; i < end; ++i) {
+        const int k = i < whole ? (i - begin) % 4 : 0;
+        const double* v = g.v + 3 * i;
+        const double speed = (v[0] * v[0] + v[1] * v[1]) + v[2] * v[2];
+        if (g.constraint[i] >= 0) {
+            const double* f = g.force + 3 * i;
+            boundary[k] += std::abs((f[0] * v[0] + f[1] * v[1]) + f[2] * v[2]);
+        }
+        if (g.constraint[i] != -1) continue;
+        kinetic[k] += 0.5 * g.mass[i] * speed;
+        const double* a = g.gravity;
+        gravity[k] += g.mass[i] * std::abs((a[0] * v[0] + a[1] * v[1]) + a[2] * v[2]);
+    }
+    GuardSums s;
+    s.kinetic = (kinetic[0] + kinetic[1]) + (kinetic[2] + kinetic[3]);
+    s.gravityPower = (gravity[0] + gravity[1]) + (gravity[2] + gravity[3]);
+    s.boundaryPower = (boundary[0] + boundary[1]) + (boundary[2] + boundary[3]);
+    return s;
+}
+
+// The scalar loop and AVX2 (ctest's kernels.scalar, kernels.avx2 and an AVX2 CPU) add in the
+// same four chains: the same bits, from a start that is not a multiple of four, with pinned and
+// driven particles in some quads.
+TEST(GuardSums, TheScalarLoopAndAvx2AddInTheSameFourChains) {
+    if (simdWidth() > 4) GTEST_SKIP() << "AVX-512 adds in eight chains";
+    for (const int n : {5, 64, 203}) {
+        Particles p = someParticles(n);
+        GuardInput g{p.v.data()->data(),
+                     p.force.data()->data(),
+                     p.mass.data(),
+                     p.constraint.data(),
+                     nullptr,
+                     30.0,
+                     {0.3, -0.2, -9.81},
+                     true};
+        for (const int begin : {0, 3}) {
+            const GuardSums got = guardSums(g, begin, n), want = fourChainGuard(g, begin, n);
+            EXPECT_GT(got.kinetic, 0.0);
+            EXPECT_EQ(got.kinetic, want.kinetic) << n << " " << begin;
+            EXPECT_EQ(got.gravityPower, want.gravityPower) << n << " " << begin;
+            EXPECT_EQ(got.boundaryPower, want.boundaryPower) << n << " " << begin;
+        }
+    }
+}
+
 // GuardInput::oneMass: the sums of every particle having that mass, to the bit, the mass array
 // unread.
 TEST(GuardSums, OneMassGivesTheSumsOfEveryParticleHavingIt) {

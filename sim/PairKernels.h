@@ -3,8 +3,8 @@
 // 27-28, the diffusion's strain and weakening, the power law's look-ahead and the elastoplastic
 // history): each pair's force on its smaller index, from structure-of-arrays inputs, for a range
 // of pairs. sim/PairSums.h sums the pair forces per particle. Eight pairs at a time
-// with AVX-512 where the CPU has it, else four with AVX2, else one at a time
-// (sim/PairKernelSimd.inc is the one kernel for both widths); all use only +, -, *, / and sqrt, and
+// with AVX-512 where the CPU has it, else eight as two AVX2 vectors, else one at a time
+// (sim/PairKernelSimd.inc is the one kernel for both); all use only +, -, *, / and sqrt, and
 // fused multiply-adds only in eq. 20's e^x (sim/LawExp.h, at every width), so their bits are the
 // same. The width is sim/StepKernels.h's simdWidth().
 
@@ -79,17 +79,17 @@ struct LinearPairInput {
 };
 inline constexpr int kSteppedClass = -2;
 
-/// Where a pair's force lies in its slots. In rows (eight lanes wide, sim/PairSums.h's tile
-/// sums): rows of kPairTile slots, the x of the row's pairs, then their y, then their z, so that
-/// eight lanes store and load them without a transpose. Else x y z 0 per slot (one load per pair
-/// for a particle's sum).
+/// Where a pair's force lies in its slots. In rows (four or eight lanes wide, sim/PairSums.h's
+/// tile sums): rows of kPairTile slots, the x of the row's pairs, then their y, then their z, so
+/// that eight lanes store and load them without a transpose. Else x y z 0 per slot (one load per
+/// pair for a particle's sum).
 inline constexpr int kSlotRow = 3 * kPairTile;
 inline std::size_t slotAt(unsigned s, bool rows) {
     return rows ? kSlotRow * std::size_t(s / kPairTile) + s % kPairTile : 4 * std::size_t(s);
 }
 /// How far apart a slot's x, y and z lie.
 inline int slotStride(bool rows) { return rows ? kPairTile : 1; }
-/// Whether the slots are in rows: the width is 8.
+/// Whether the slots are in rows: the width is 4 or 8.
 bool slotRows();
 
 struct LinearPairOutput {

@@ -97,9 +97,12 @@ struct Sums {
         slots.assign(kTile + 2 * std::size_t(this->layout.stride) + last + 2 * kTile, 0.0);
         for (std::size_t k = kTile; k < slots.size(); ++k)
             slots[k] = 2.0 * uniformFromHash(11, int(k)) - 1.0;
+        // Some dead in the first half of the bonds, where most tiles have one; some "alive"
+        // as 2; every bond of the second half's tiles alive.
+        const int half = int(alive.size()) / 2;
         for (int b = 0; b < int(alive.size()); ++b) {
-            const double draw = uniformFromHash(12, b);  // some dead, some "alive" as 2
-            alive[b] = draw < 0.1 ? 0 : draw < 0.2 ? 2 : 1;
+            const double draw = uniformFromHash(12, b);
+            alive[b] = draw < 0.1 && b < half ? 0 : draw < 0.2 ? 2 : 1;
         }
     }
     /// The sums of particles [begin, end), with or without the tiles, with their stores

@@ -219,6 +219,25 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
     __m256d low = _mm256_setzero_pd(), high = low;
     const int first = d.tileBegin[t] / 8;
+    std::uint64_t lives;  // the eight rows' living bytes
+    std::memcpy(&lives, d.livingRows.data() + first, sizeof lives);
+    // Every bond lives: the same adds, without the masks (cpu-clock samples on one Zen 3 core,
+    // crack_path_sources at 10^4, linear: 0.18 of the pair kernel's -> 0.14).
+    if (lives == ~std::uint64_t(0)) {
+#pragma GCC unroll 8
+        for (int k = 0; k < 8; ++k) {
+            const int row = first + k;
+            const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
+            const double* other = theta + d.rowRun[row];
+            low = _mm256_add_pd(low,
+                                _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other), ownLow)));
+            high = _mm256_add_pd(
+                high, _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other + 4), ownHigh)));
+        }
+        _mm256_storeu_pd(next + 8 * t, _mm256_add_pd(ownLow, _mm256_mul_pd(step, low)));
+        _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
+        return;
+    }
 #pragma GCC unroll 8
     for (int k = 0; k < 8; ++k) {
         const int row = first + k, lives = d.livingRows[row];

@@ -161,6 +161,7 @@ namespace avx2 {
 using V = __m256d;
 using M = __m256d;
 constexpr int kLanes = 4;
+constexpr int kRootRows = 0;  // PairKernelSimd.inc: each row's root in its pass
 
 // Four lanes; a mask is all ones or all zeros per lane.
 struct Simd {
@@ -261,6 +262,15 @@ struct V {
 using M = V;
 using Half = avx2::Simd;
 constexpr int kLanes = 8;
+// The rows' roots sixteen at a time (PairKernelSimd.inc's kRootRows), then their forces: the
+// roots were the kernel's longest wait (a fifth of its cpu-clock samples on the instruction after
+// them), each row's root and division behind the row before's, with its ~200 instructions
+// filling the core's window. Apart, sixteen roots (a 5 KiB buffer) issue back to back. On one
+// Zen 3 core, crack_path_sources at 10^4, fastest of ten alternate runs, ns per particle-step:
+// linear 23.0 -> 21.2 (8 rows 21.5, 32 rows 21.2), power law 27.4 -> 25.8, elastoplastic 27.0 ->
+// 25.4, stretch 16.6 -> 15.6; one row ahead in the same loop instead: 22.1. On the AVX-512 Zen 5
+// the same split was slower (README, issue 16), so the avx512 loop keeps one pass.
+constexpr int kRootRows = 16;
 
 struct Simd {
     static V set1(double a) { return {Half::set1(a), Half::set1(a)}; }
@@ -340,6 +350,7 @@ namespace avx512 {
 using V = __m512d;
 using M = __mmask8;
 constexpr int kLanes = 8;
+constexpr int kRootRows = 0;  // PairKernelSimd.inc: each row's root in its pass
 
 // Eight lanes: on CPUs whose dividers are 512 bits wide (AMD Zen 5), twice the ÷ and √ of AVX2
 // per instruction. Masks are bits.
@@ -431,6 +442,13 @@ template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = in.stiffestKnown;
 #if defined(__x86_64__)
+    // The eight-lane loops take whole rows (PairKernelSimd.inc's laneOf): the pairs before the
+    // first row's start, if any, one by one.
+    if (simdWidth() >= 4 && begin % kPairTile != 0) {
+        const int row = std::min(end, begin + kPairTile - begin % kPairTile);
+        stiffest = std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, row));
+        begin = row;
+    }
     constexpr bool kLookAhead = kLaw == BondLawKind::PowerLaw && kUpdate;
     if (kLookAhead && in.skipFar && simdWidth() == 8)
         begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead>(in, out, begin, end,
@@ -462,6 +480,8 @@ bool slotRows() { return simdWidth() >= 4; }
 double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int begin, int end) {
     double fastest = 0.0;
 #if defined(__x86_64__)
+    for (; begin < end && begin % kPairTile != 0; ++begin)  // whole rows, as pairs()
+        fastest = std::max(fastest, approachOf(in, a, begin));
     if (simdWidth() == 8)
         begin = in.theta ? avx512::approachSimd<true>(in, a, begin, end, fastest)
                          : avx512::approachSimd<false>(in, a, begin, end, fastest);

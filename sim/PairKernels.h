@@ -109,7 +109,7 @@ struct LinearPairOutput {
     int stride = kPairTile;
     /// Pair u's x; its y and z slotStep() and twice that after.
     double* slot(int u) const {
-        return rowSlot ? force + rowSlot[u / kPairTile] + u % kPairTile
+        return rowSlot ? force + rowSlot[unsigned(u) / kPairTile] + unsigned(u) % kPairTile
                        : force + slotAt(unsigned(u - slotBase), rows);
     }
     int slotStep() const { return rowSlot ? stride : slotStride(rows); }

@@ -490,22 +490,142 @@ template <int kBonds>
     storeRun4(out + 12, x1, y1, z1);
 }
 
-/// Tile t at four lanes: a regular group whose bonds all live by its rows, else one particle
-/// at a time (a general group's rows, masked at four lanes, were no faster: the tiles across a
-/// lattice row's ends and those where a bond broke are few).
-[[gnu::target("avx2")]] void sumTileAvx2(const PairGather& g, const PairSumTiles& s, int t) {
+// Four lanes' masks and the other tiles (sumGroupTileAvx2, sumUnionTileAvx2): a tile of one
+// group whose bonds do not all live or whose rows lie in two runs, and a tile across a lattice
+// row's ends, by masked rows as the AVX-512 sumTile's, each lane's terms in its bond order, a
+// masked-off lane's sum left as it was (a blend, not + 0.0: -0.0 + 0.0 is +0.0): the same bits.
+// One particle at a time, those tiles were half of the sums' cpu-clock samples on
+// crack_path_sources at 10^4 (186 of its 1,275 tiles a step: 113 across a row's ends, 64 of one
+// group not regular, 9 regular with a broken bond); by rows, the sums' fastest step on one Zen 3
+// core fell from 105,000-137,000 to 89,000-92,000 TSC cycles (three runs each), the step's
+// ns per particle from 22.0 to 21.7 (linear), 26.3 to 26.2 (power law), 25.8 to 25.2
+// (elastoplastic; fastest of 8-12 alternate runs). The branches on a union row's runs and
+// halves stay: without them, 94,000.
+#define REND_TILE_AVX2 gnu::target("avx2,bmi2")
+
+/// Bits 0-3 of `bits` as four lanes' masks.
+[[REND_TILE_AVX2]] inline __m256d laneMask(unsigned bits) {
+    const __m256i lane = _mm256_setr_epi64x(1, 2, 4, 8);
+    const __m256i set = _mm256_and_si256(_mm256_set1_epi64x(bits), lane);
+    return _mm256_castsi256_pd(_mm256_cmpeq_epi64(set, lane));
+}
+
+/// Bit k: flag k of 32 from `alive` is zero.
+[[REND_TILE_AVX2]] inline std::uint64_t deadBits(const std::uint8_t* alive) {
+    const __m256i flags = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(alive));
+    return unsigned(_mm256_movemask_epi8(_mm256_cmpeq_epi8(flags, _mm256_setzero_si256())));
+}
+
+/// Bit k: life flag k of `count` (at most 64) from `alive` is nonzero. `readable`: 64 bytes
+/// from `alive` may be read.
+[[REND_TILE_AVX2]] inline std::uint64_t lifeBits(const std::uint8_t* alive, int count,
+                                                 bool readable) {
+    alignas(32) std::uint8_t copy[64] = {};
+    if (!readable) std::memcpy(copy, alive, std::size_t(count)), alive = copy;
+    const std::uint64_t living = ~(deadBits(alive) | deadBits(alive + 32) << 32);
+    return count >= 64 ? living : living & ((std::uint64_t(1) << count) - 1);
+}
+
+/// Eight lanes' sums as two halves of four.
+struct HalfSums {
+    __m256d x[2], y[2], z[2];
+};
+
+/// sum + f (minus: sum - f) in the lanes `keep`, sum in the others.
+[[REND_TILE_AVX2]] inline __m256d addTerm(__m256d sum, __m256d f, __m256d keep, bool minus) {
+    return _mm256_blendv_pd(sum, minus ? _mm256_sub_pd(sum, f) : _mm256_add_pd(sum, f), keep);
+}
+
+/// Half h's terms (x, y, z) added to, or taken from, its lanes `on`.
+[[REND_TILE_AVX2]] inline void addHalf(HalfSums& s, int h, __m256d fx, __m256d fy, __m256d fz,
+                                       unsigned on, bool minus) {
+    const __m256d keep = laneMask(on >> (4 * h));
+    s.x[h] = addTerm(s.x[h], fx, keep, minus), s.y[h] = addTerm(s.y[h], fy, keep, minus);
+    s.z[h] = addTerm(s.z[h], fz, keep, minus);
+}
+
+[[REND_TILE_AVX2]] inline void storeHalves(double* out, const HalfSums& s) {
+    storeRun4(out, s.x[0], s.y[0], s.z[0]);
+    storeRun4(out + 12, s.x[1], s.y[1], s.z[1]);
+}
+
+/// Half h's four doubles from a (the lanes of fromA) and b (the others).
+[[REND_TILE_AVX2]] inline __m256d halfOf(const double* a, const double* b, unsigned fromA, int h) {
+    const __m256d fromRunA = _mm256_loadu_pd(a + 4 * h);
+    if (fromA == 0xff) return fromRunA;
+    return _mm256_blendv_pd(_mm256_loadu_pd(b + 4 * h), fromRunA, laneMask(fromA >> (4 * h)));
+}
+
+/// A tile of one group of eight lanes with at most eight bonds each (PairSumTiles::Group).
+[[REND_TILE_AVX2]] void sumGroupTileAvx2(const PairGather& g, const PairSumTiles& s,
+                                         const PairSumTiles::Group& one, int t) {
+    const int base = g.offsets[kTile * t], bonds = one.bonds;
+    const std::uint64_t life =
+        lifeBits(g.alive + base, kTile * bonds, base + 64 <= s.directedBonds);
+    std::uint64_t stride = 0;  // bit 0 of each lane's flags
+    for (int l = 0; l < kTile; ++l) stride |= std::uint64_t(1) << (l * bonds);
+    HalfSums sum{};
+    const int y = g.stride, z = 2 * g.stride;
+    for (int k = 0; k < bonds; ++k) {
+        const PairSumTiles::Row& r = s.rows[one.rowFirst + k];
+        const double *a = g.pairForce + r.atA, *b = g.pairForce + r.atB;
+        const unsigned on = unsigned(_pext_u64(life, stride << k));
+        for (int h = 0; h < 2; ++h)
+            addHalf(sum, h, halfOf(a, b, r.fromA, h), halfOf(a + y, b + y, r.fromA, h),
+                    halfOf(a + z, b + z, r.fromA, h), on, k < one.lower);
+    }
+    storeHalves(g.forceOf(kTile * t), sum);
+}
+
+/// Half h of a union row's x (or y, z: `at` after): run A's load, runs B and C blended in.
+[[REND_TILE_AVX2]] inline __m256d unionHalf(const double* pairForce,
+                                            const PairSumTiles::UnionRow& r, int at, int h) {
+    __m256d v = _mm256_loadu_pd(pairForce + r.at[0] + at + 4 * h);
+    for (int run = 1; run < 3; ++run)
+        if (const unsigned from = unsigned(r.from[run]) >> (4 * h) & 15u; from != 0)
+            v = _mm256_blendv_pd(v, _mm256_loadu_pd(pairForce + r.at[run] + at + 4 * h),
+                                 laneMask(from));
+    return v;
+}
+
+/// A tile across a lattice row's ends (PairSumTiles::kUnion), as sumUnionTile.
+[[REND_TILE_AVX2]] void sumUnionTileAvx2(const PairGather& g, const PairSumTiles& s,
+                                         const PairSumTiles::Group& one, int t) {
+    const int base = g.offsets[kTile * t], flags = g.offsets[kTile * (t + 1)] - base;
+    const std::uint64_t life = lifeBits(g.alive + base, flags, base + 64 <= s.directedBonds);
+    HalfSums sum{};
+    for (int q = one.rowFirst; q < one.rowFirst + one.bonds; ++q) {
+        const PairSumTiles::UnionRow& r = s.unionRows[q];
+        const unsigned on = unsigned(_pdep_u64(_pext_u64(life, r.select), r.having));
+        for (int h = 0; h < 2; ++h)
+            if ((on >> (4 * h) & 15u) != 0)
+                addHalf(sum, h, unionHalf(g.pairForce, r, 0, h),
+                        unionHalf(g.pairForce, r, g.stride, h),
+                        unionHalf(g.pairForce, r, 2 * g.stride, h), on, r.minus);
+    }
+    storeHalves(g.forceOf(kTile * t), sum);
+}
+
+/// Tile t at four lanes: a regular group whose bonds all live by its rows, unmasked; a tile of
+/// one group of at most eight bonds, or across a row's ends, by masked rows; else one particle
+/// at a time.
+[[REND_TILE_AVX2]] void sumTileAvx2(const PairGather& g, const PairSumTiles& s, int t) {
     const PairSumTiles::Group& one = s.groups[s.groupFirst[t]];
     const int base = kTile * t;
-    if (one.endLane == kTile && one.regular && (one.bonds == 8 || one.bonds == 6) &&
-        allLiving(g.alive + g.offsets[base], kTile * one.bonds)) {
-        const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
-        if (one.bonds == 8) return sumRegularTileAvx2<8>(g, rows, g.forceOf(base));
-        return sumRegularTileAvx2<6>(g, rows, g.forceOf(base));
+    if (one.endLane == kTile) {
+        if (one.lower == PairSumTiles::kUnion) return sumUnionTileAvx2(g, s, one, t);
+        if (one.regular && (one.bonds == 8 || one.bonds == 6) &&
+            allLiving(g.alive + g.offsets[base], kTile * one.bonds)) {
+            const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
+            if (one.bonds == 8) return sumRegularTileAvx2<8>(g, rows, g.forceOf(base));
+            return sumRegularTileAvx2<6>(g, rows, g.forceOf(base));
+        }
+        if (one.bonds > 0 && one.bonds <= 8) return sumGroupTileAvx2(g, s, one, t);
     }
     for (int i = base; i < base + kTile; ++i) gatherParticle(g, i);
 }
 
-[[gnu::target("avx2")]] void gatherTilesAvx2(const PairGather& g, int begin, int end) {
+[[REND_TILE_AVX2]] void gatherTilesAvx2(const PairGather& g, int begin, int end) {
     const PairSumTiles& s = *g.tiles;
     int i = begin;
     for (; i < end && i % kTile != 0; ++i) gatherParticle(g, i);
@@ -519,7 +639,8 @@ template <int kBonds>
 void gatherPairForces(const PairGather& g, int begin, int end) {
 #if defined(__x86_64__)
     if (g.rows && g.tiles && simdWidth() == 8) return gatherTiles(g, begin, end);
-    if (g.rows && g.tiles && simdWidth() == 4) return gatherTilesAvx2(g, begin, end);
+    static const bool bmi2 = __builtin_cpu_supports("bmi2");
+    if (g.rows && g.tiles && simdWidth() == 4 && bmi2) return gatherTilesAvx2(g, begin, end);
 #endif
     gatherLoop(g, begin, end);
 }

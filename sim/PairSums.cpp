@@ -432,7 +432,7 @@ template <int kBonds, bool kRegular>
 
 // Four lanes (AVX2): a tile of one regular group (a lattice's interior, sim/PairSums.h) whose
 // bonds all live as two halves of four particles, their rows' terms in each lane's bond order:
-// the same bits as one particle at a time, which sums every other tile. One particle at a time
+// the same bits as one particle at a time (and as the masked rows below). One particle at a time
 // (x y z 0 slots) each term waited on the one before, a chain of eight adds: on one Zen 3 core,
 // crack_path_sources at 10^4, linear law, the sums' cpu-clock samples fell from 0.38 of the pair
 // kernel's to 0.26; with the blow-up guard's AVX2 loop, alternate runs 32.4 -> 28.2 and 34.2 ->

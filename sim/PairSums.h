@@ -2,8 +2,8 @@
 // The second pass of the vectorised force loop (sim/PairKernels.h computes each pair's force
 // into a slot): each particle's sum of its living bonds' pair forces in CSR order, minus where it
 // is the pair's larger index (sim/Bonds.h's BondPairs). One particle at a time, or, with
-// AVX-512, eight at once (with AVX2, the regular tiles below whose bonds all live, as two halves
-// of four): a tile (sim/PeridynamicBonds.h's order) whose particles have the same
+// AVX-512, eight at once (with AVX2 and BMI2, as two halves of four; a tile of several groups
+// one particle at a time): a tile (sim/PeridynamicBonds.h's order) whose particles have the same
 // number of bonds, the same number of lower copies and, bond by bond, their pairs in at most two
 // runs of consecutive slots, as almost every tile of a regular lattice has; or a tile whose
 // particles' bonds differ (where a lattice's row ends) as one group over their partner offsets,

@@ -102,10 +102,11 @@ void DiffusionTiles::setUpRows() {
     plainTile.assign(std::max(tiles, 0), 0);
     for (int t = 0; t < tiles; ++t) {
         const int first = tileBegin[t] / kTile, end = tileBegin[t + 1] / kTile;
-        bool plain = end - first == kTile;
+        const int rows = end - first;
+        bool plain = rows == 6 || rows == 8 || rows == 12;
         for (int row = first; row < end && plain; ++row)
             plain = rowRun[row] >= 0 && rowClass[row] >= 0;
-        plainTile[t] = plain;
+        plainTile[t] = plain ? std::uint8_t(rows) : 0;
     }
 }
 
@@ -174,7 +175,7 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     for (int t = firstTile; t < lastTile; ++t) {
         const __m512d own = _mm512_loadu_pd(theta + 8 * t);
         __m512d flux = _mm512_setzero_pd();
-        if (plain[t]) {
+        if (plain[t] == 8) {
             // The loop below's terms for a tile of eight runs with one rate each: unrolled, its
             // rows' tests left out and their living bytes read as one word (the diffusion alone,
             // crack_path_sources, linear, pinned: 1.26 -> 0.93 ns per particle-step at 10^4,
@@ -207,11 +208,24 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     }
 }
 
-// A plain tile (DiffusionTiles::plainTile) in two halves of four lanes: its rows' runs as
-// plain loads, each row's rate from its class once for both; the same terms in the same order as
-// the loop below, which reads each slot's partner and rate (REND_SIMD=avx2, the diffusion alone,
-// crack_path_sources, linear, pinned: 2.66 -> 1.52 ns per particle-step at 10^4, 5.27 -> 1.66
-// at 10^6).
+/// Whether the kRows bytes from `rows` are all 0xff.
+template <int kRows>
+inline bool allRowsLive(const std::uint8_t* rows) {
+    std::uint64_t first = ~std::uint64_t(0), rest = ~std::uint64_t(0);
+    std::memcpy(&first, rows, std::min(kRows, 8));
+    if constexpr (kRows > 8) std::memcpy(&rest, rows + 8, kRows - 8);
+    return (first & rest) == ~std::uint64_t(0);
+}
+
+// A plain tile (DiffusionTiles::plainTile) of kRows rows in two halves of four lanes: its rows'
+// runs as plain loads, each row's rate from its class once for both; the same terms in the
+// same order as the loop below, which reads each slot's partner and rate (REND_SIMD=avx2, the
+// diffusion alone, crack_path_sources, linear, pinned: 2.66 -> 1.52 ns per particle-step at
+// 10^4, 5.27 -> 1.66 at 10^6). Six rows are the hexagonal sheets' (every shipped scene's),
+// twelve a square sheet's of horizon 2.2; taking them here rather than by the loop below took
+// crack_path_sources on its hexagonal lattice at 10^4 (linear, one Zen 3 core, fastest of eight
+// alternate runs) from 19.3 to 18.1 ns per particle-step, the same bits.
+template <int kRows>
 [[gnu::target("avx2")]] inline void diffusePlainTile(const DiffusionTiles& d, const double* theta,
                                                      double* next, __m256d step, __m256i laneBit,
                                                      int t) {
@@ -219,13 +233,11 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
     __m256d low = _mm256_setzero_pd(), high = low;
     const int first = d.tileBegin[t] / 8;
-    std::uint64_t lives;  // the eight rows' living bytes
-    std::memcpy(&lives, d.livingRows.data() + first, sizeof lives);
     // Every bond lives: the same adds, without the masks (cpu-clock samples on one Zen 3 core,
     // crack_path_sources at 10^4, linear: 0.18 of the pair kernel's -> 0.14).
-    if (lives == ~std::uint64_t(0)) {
-#pragma GCC unroll 8
-        for (int k = 0; k < 8; ++k) {
+    if (allRowsLive<kRows>(d.livingRows.data() + first)) {
+#pragma GCC unroll 12
+        for (int k = 0; k < kRows; ++k) {
             const int row = first + k;
             const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
             const double* other = theta + d.rowRun[row];
@@ -238,8 +250,8 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
         _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
         return;
     }
-#pragma GCC unroll 8
-    for (int k = 0; k < 8; ++k) {
+#pragma GCC unroll 12
+    for (int k = 0; k < kRows; ++k) {
         const int row = first + k, lives = d.livingRows[row];
         const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
         const double* other = theta + d.rowRun[row];
@@ -286,9 +298,18 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
     const __m256d step = _mm256_set1_pd(dt);
     const __m256i laneBit = _mm256_setr_epi64x(1, 2, 4, 8);
     for (int t = firstTile; t < lastTile; ++t) {
-        if (d.plainTile[t]) {
-            diffusePlainTile(d, theta, next, step, laneBit, t);
-            continue;
+        switch (d.plainTile[t]) {
+            case 6:
+                diffusePlainTile<6>(d, theta, next, step, laneBit, t);
+                continue;
+            case 8:
+                diffusePlainTile<8>(d, theta, next, step, laneBit, t);
+                continue;
+            case 12:
+                diffusePlainTile<12>(d, theta, next, step, laneBit, t);
+                continue;
+            default:
+                break;
         }
         for (int half = 0; half < 8; half += 4) {
             const __m256d own = _mm256_loadu_pd(theta + 8 * t + half);

@@ -29,8 +29,9 @@ struct DiffusionTiles {
     std::vector<double> classRate, classUnit;
     std::vector<std::uint16_t> rateSteps;
     static constexpr int kSteppedRate = -2;
-    /// Per tile: 1 where it has kTile rows, each a run with one rate (a regular lattice's
-    /// interior), whose sums are straight code.
+    /// Per tile: its number of rows where it has 6, 8 or 12, each a run with one rate (a
+    /// regular lattice's interior: hexagonal, square, square of horizon 2.2), whose sums are
+    /// straight code (the AVX-512 sums' for 8 rows only); else 0.
     std::vector<std::uint8_t> plainTile;
     /// Per row, bit l: slot kTile row + l's bond lives (refresh()); 0 for a pad.
     std::vector<std::uint8_t> livingRows;

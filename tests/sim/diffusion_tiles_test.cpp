@@ -23,12 +23,13 @@ namespace {
 /// square within 1.5 dx (31 particles a row: a tile in four holds a row's end, as rows of one
 /// offset): the edges' particles have fewer bonds than the interior's, so tiles there carry pads.
 struct Sheet {
-    explicit Sheet(LatticeKind kind = LatticeKind::Hexagonal) {
+    /// horizon 0: the kind's above.
+    explicit Sheet(LatticeKind kind = LatticeKind::Hexagonal, double horizon = 0.0) {
         const bool square = kind == LatticeKind::Square;
         params.sheet.size = {square ? 0.30 : 0.31, 0.17};
         params.sheet.dx = 0.01;
         params.sheet.lattice = kind;
-        params.sheet.horizonFactor = square ? 1.5 : 2.5;
+        params.sheet.horizonFactor = horizon > 0.0 ? horizon : square ? 1.5 : 2.5;
         params.material.density = 5000.0, params.material.capacity = 1.0;
         params.material.conductivity = 50.0;
         lattice = generateLattice(params.sheet);
@@ -106,15 +107,15 @@ TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
     if (rates == Rates::Random) EXPECT_EQ(tiles.classedRows(), 0);
     if (rates != Rates::Random) EXPECT_GT(tiles.classedRows(), allRows * 3 / 4);
     if (rates == Rates::Stepped) EXPECT_GT(stepped, allRows / 2);
-    // Tiles of eight runs with one rate each sum as straight code (plainTile): never where each
-    // rate is its own (PlainTilesSumAsTheLoopDoes below takes that path).
+    // Tiles of 6, 8 or 12 runs with one rate each sum as straight code (plainTile): never where
+    // each rate is its own (PlainTiles.SumAsTheLoopDoes below takes that path).
     const int tileCount = int(tiles.tileBegin.size()) - 1;
     ASSERT_EQ(int(tiles.plainTile.size()), tileCount);
     if (rates == Rates::Random)
-        EXPECT_EQ(std::count(tiles.plainTile.begin(), tiles.plainTile.end(), 1), 0);
+        EXPECT_EQ(std::count(tiles.plainTile.begin(), tiles.plainTile.end(), 0), tileCount);
     for (int t = 0; t < tileCount; ++t)
         if (tiles.plainTile[t]) {
-            EXPECT_EQ(tiles.tileBegin[t + 1] - tiles.tileBegin[t], kTile * kTile);
+            EXPECT_EQ(tiles.tileBegin[t + 1] - tiles.tileBegin[t], kTile * tiles.plainTile[t]);
             for (int row = tiles.tileBegin[t] / kTile; row < tiles.tileBegin[t + 1] / kTile; ++row)
                 EXPECT_TRUE(tiles.rowRun[row] >= 0 && tiles.rowClass[row] >= 0) << row;
         }
@@ -141,11 +142,21 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Combine(::testing::Values(LatticeKind::Hexagonal, LatticeKind::Square),
                        ::testing::Values(Rates::Random, Rates::Lattice, Rates::Stepped)));
 
-// The square sheet's own rates (one exact value per direction) make most tiles plain: eight
-// runs with one rate each, summed as straight code with the rows' living bytes read as one
-// word. With some bonds dead, and tiles with all of them living, the sums keep the loop's bits.
-TEST(DiffusionTiles, PlainTilesSumAsTheLoopDoes) {
-    const Sheet sheet(LatticeKind::Square);
+// A regular sheet's own rates (one exact value per direction) make most tiles plain: a run with
+// one rate per row, summed as straight code with the rows' living bytes read as words; six rows
+// on a hexagonal sheet, eight on a square one, twelve on a square one of horizon 2.2. With some
+// bonds dead, and tiles with all of them living, the sums keep the loop's bits.
+struct PlainCase {
+    LatticeKind lattice;
+    double horizon;
+    int rows;  ///< of its plain tiles
+};
+
+class PlainTiles : public ::testing::TestWithParam<PlainCase> {};
+
+TEST_P(PlainTiles, SumAsTheLoopDoes) {
+    const PlainCase c = GetParam();
+    const Sheet sheet(c.lattice, c.horizon);
     const BondFamilies& bonds = sheet.bonds;
     const int n = bonds.particleCount();
     const Diffusion diffusion(sheet.params, sheet.lattice.positions, bonds, sheet.volumes);
@@ -155,11 +166,14 @@ TEST(DiffusionTiles, PlainTilesSumAsTheLoopDoes) {
         if (tiles.bond[u] >= 0) rate[tiles.bond[u]] = tiles.rate[u];
     std::vector<std::uint8_t> alive(bonds.directedCount(), 1);
     for (int b = 0; b < bonds.offsets[n / 2]; b += 11) alive[b] = 0;  // the first half's
+    // In the second half every fifth tile's first particle loses its last bond only: a dead
+    // bond in a tile's last row (past the first eight of twelve).
+    constexpr int kTile = DiffusionTiles::kTile;
+    for (int i = n / 2 + kTile; i < n; i += 5 * kTile) alive[bonds.offsets[i + 1] - 1] = 0;
     tiles.refresh(alive.data(), 1);
     std::vector<double> theta(n);
     for (int i = 0; i < n; ++i) theta[i] = 40.0 * (uniformFromHash(5, i) - 0.5);
     const double dt = 1e-3;
-    constexpr int kTile = DiffusionTiles::kTile;
     const int whole = n / kTile;
     std::vector<double> next(n, -1.0);
     diffuseTiles(tiles, theta.data(), next.data(), dt, 0, whole);
@@ -169,7 +183,7 @@ TEST(DiffusionTiles, PlainTilesSumAsTheLoopDoes) {
     EXPECT_EQ(std::memcmp(next.data(), expected.data(), n * sizeof(double)), 0);
     int plain = 0, plainWithDead = 0;
     for (int t = 0; t < whole; ++t) {
-        if (!tiles.plainTile[t]) continue;
+        if (tiles.plainTile[t] != c.rows) continue;  // a square sheet's edges: 8 of 12 too
         ++plain;
         for (int row = tiles.tileBegin[t] / kTile; row < tiles.tileBegin[t + 1] / kTile; ++row)
             if (tiles.livingRows[row] != 0xff) {
@@ -181,6 +195,11 @@ TEST(DiffusionTiles, PlainTilesSumAsTheLoopDoes) {
     EXPECT_GT(plainWithDead, 0);
     EXPECT_LT(plainWithDead, plain);
 }
+
+INSTANTIATE_TEST_SUITE_P(Lattices, PlainTiles,
+                         ::testing::Values(PlainCase{LatticeKind::Hexagonal, 1.5, 6},
+                                           PlainCase{LatticeKind::Square, 1.5, 8},
+                                           PlainCase{LatticeKind::Square, 2.2, 12}));
 
 // A diffusion that stepped before some bonds broke steps afterwards as one built on the broken
 // bonds does: its copy of which bonds live follows DamageState::version().

@@ -7,8 +7,9 @@
 // compared with, on the same core, and the faster run's ratio to rend is printed. Then,
 // per bond law (linear, power_law, elastoplastic), ns per particle-step on 1 thread of the same
 // sheet, and of crack_path_sources (its notch breaking, two heat sources diffusing: theta and
-// breaking on), both square at dt 1e-4; with --largest 1e6 or more, crack_path_sources too on a
-// sheet 20 m square at its spacing (1,002,001 particles, 20 steps in), and with 1e7 on one
+// breaking on), both square at dt 1e-4, and crack_path_sources on its own hexagonal lattice (every
+// shipped scene's: 6 bonds a particle, not 8); with --largest 1e6 or more, crack_path_sources too
+// on a sheet 20 m square at its spacing (1,002,001 particles, 20 steps in), and with 1e7 on one
 // 63.24 m square (10,004,569 particles, 5 steps in). The linear and
 // elastoplastic laws again with the kick and drift in their own pass after the forces
 // (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves. And the
@@ -256,11 +257,13 @@ constexpr const char* kLaws[] = {"linear", "power_law", "elastoplastic"};
 /// ns per particle-step on 1 thread of `scene` with [material] law = `law`, after `warm` steps;
 /// with `side` > 0, on a sheet `side` metres square at the scene's spacing.
 /// With `diffusion`, the diffusion alone of the same membrane after the steps
-/// (diffusionNsPerParticleStep) too.
+/// (diffusionNsPerParticleStep) too. On the square lattice, or with `hexagonal` the scene's own
+/// (every shipped scene's: 6 bonds a particle where the square one has 8).
 double lawRow(const std::string& scene, const char* law, double side = 0.0, int warm = 200,
-              bool kickInPass = true, double* diffusion = nullptr) {
-    std::vector<std::string> sets = {"sheet.lattice=\"square\"", "time.dt=1e-4",
-                                     std::string("material.law=\"") + law + "\""};
+              bool kickInPass = true, double* diffusion = nullptr, bool hexagonal = false) {
+    std::vector<std::string> sets = {
+        hexagonal ? "sheet.lattice=\"hexagonal\"" : "sheet.lattice=\"square\"", "time.dt=1e-4",
+        std::string("material.law=\"") + law + "\""};
     if (side > 0.0) {
         const std::string size = std::to_string(side);
         sets.push_back("sheet.size=[" + size + ", " + size + "]");
@@ -356,23 +359,25 @@ int main(int argc, char** argv) {
     // The per-law rows first, while the machine is quiet: freeing the 10^7 sheet's 9 GB keeps
     // the kernel busy for a while after it.
     const bool lmp = std::system("command -v lmp > /dev/null 2>&1") == 0;
-    std::vector<std::array<Paired, 4>> laws;
+    std::vector<std::array<Paired, 5>> laws;
     // crack_path_sources at 10^6 and at 10^7 particles too, where --largest reaches them (the
     // kick in its own pass not at 10^7: a minute's set-up for each row).
     const bool large = largest >= 1000000, huge = largest >= 10000000;
-    std::array<double, 4> diffusion{};  // the diffusion alone, of the linear law's membranes
+    std::array<double, 5> diffusion{};  // the diffusion alone, of the linear law's membranes
     const auto row = [&](const char* law, bool kickInPass) {
         const bool linear = std::string(law) == "linear" && kickInPass;
         int cell = 0;
-        const auto crack = [&](double side, int warm) {
+        const auto crack = [&](double side, int warm, bool hexagonal = false) {
             double* alone = linear ? &diffusion[++cell] : nullptr;
             return paired(lmp, [&] {
-                return lawRow("crack_path_sources.toml", law, side, warm, kickInPass, alone);
+                return lawRow("crack_path_sources.toml", law, side, warm, kickInPass, alone,
+                              hexagonal);
             });
         };
-        return std::array<Paired, 4>{
+        // Evaluated in this order (a braced list's), as the diffusion's cells are numbered.
+        return std::array<Paired, 5>{
             paired(lmp, [&] { return lawRow("stretch.toml", law, 0.0, 200, kickInPass); }),
-            crack(0.0, 200), large ? crack(20.0, 20) : Paired{},
+            crack(0.0, 200), crack(0.0, 200, true), large ? crack(20.0, 20) : Paired{},
             huge && kickInPass ? crack(63.24, 5) : Paired{}};
     };
     for (const char* law : kLaws) laws.push_back(row(law, true));
@@ -400,11 +405,14 @@ int main(int argc, char** argv) {
             "faster\n",
             at1e4.lammps, at1e4.ns, at1e4.lammps / at1e4.ns);
     }
-    std::printf("\nns per particle-step, 1 thread, square lattice, dt 1e-4, per bond law\n");
-    const int columns = 2 + int(large) + int(huge);
+    std::printf(
+        "\nns per particle-step, 1 thread, square lattice (one column the scene's own hexagonal "
+        "one), dt 1e-4, per bond law\n");
+    const int columns = 3 + int(large) + int(huge);
     const char* headers[] = {"stretch (10,201)", "crack_path_sources (theta, breaking)",
-                             "the same at 1,002,001", "the same at 10,004,569"};
-    const int widths[] = {18, 36, 26, 26};
+                             "the same, hexagonal (11,658)", "the same at 1,002,001",
+                             "the same at 10,004,569"};
+    const int widths[] = {18, 36, 28, 26, 26};
     const char* names[] = {kLaws[0], kLaws[1], kLaws[2], "linear, kick in own pass",
                            "elastoplastic, kick in own pass"};
     const auto table = [&](auto&& cell) {

@@ -108,7 +108,7 @@ TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
     if (rates != Rates::Random) EXPECT_GT(tiles.classedRows(), allRows * 3 / 4);
     if (rates == Rates::Stepped) EXPECT_GT(stepped, allRows / 2);
     // Tiles of 6, 8 or 12 runs with one rate each sum as straight code (plainTile): never where
-    // each rate is its own (PlainTiles.SumAsTheLoopDoes below takes that path).
+    // each rate is its own (DiffusionTilesPlain.SumAsTheLoopDoes below takes that path).
     const int tileCount = int(tiles.tileBegin.size()) - 1;
     ASSERT_EQ(int(tiles.plainTile.size()), tileCount);
     if (rates == Rates::Random)
@@ -152,9 +152,9 @@ struct PlainCase {
     int rows;  ///< of its plain tiles
 };
 
-class PlainTiles : public ::testing::TestWithParam<PlainCase> {};
+class DiffusionTilesPlain : public ::testing::TestWithParam<PlainCase> {};
 
-TEST_P(PlainTiles, SumAsTheLoopDoes) {
+TEST_P(DiffusionTilesPlain, SumAsTheLoopDoes) {
     const PlainCase c = GetParam();
     const Sheet sheet(c.lattice, c.horizon);
     const BondFamilies& bonds = sheet.bonds;
@@ -196,7 +196,7 @@ TEST_P(PlainTiles, SumAsTheLoopDoes) {
     EXPECT_LT(plainWithDead, plain);
 }
 
-INSTANTIATE_TEST_SUITE_P(Lattices, PlainTiles,
+INSTANTIATE_TEST_SUITE_P(Lattices, DiffusionTilesPlain,
                          ::testing::Values(PlainCase{LatticeKind::Hexagonal, 1.5, 6},
                                            PlainCase{LatticeKind::Square, 1.5, 8},
                                            PlainCase{LatticeKind::Square, 2.2, 12}));

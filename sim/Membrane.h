@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -97,6 +98,12 @@ public:
     void setKickInPass(bool on) { kickInPass_ = on; }
     /// Whether the last step's particles moved inside the force pass.
     bool keptKickInPass() const { return keptKickInPass_; }
+    /// Whether advanceTo may measure a step's failure approach rate in the next step's force
+    /// pass, and choose that step's length after it (the same bits, one pass over the pairs
+    /// fewer); on by default. Off: a pass of its own after every step (tests, the benchmark).
+    void setApproachInPass(bool on) { approachInPass_ = on; }
+    /// The steps whose failure approach rate the next step's force pass measured, so far.
+    long approachesInPass() const { return approachesInPass_; }
     /// The blow-up guard's energy budget so far [J]: the start's energy and the work the
     /// boundaries (|force . v| on the driven particles), gravity and the rest did since.
     double energyBudget() const { return guard_.budget(); }
@@ -188,7 +195,15 @@ private:
     void useSolver(std::unique_ptr<Solver> solver);
     /// The solver's forces (updating its state) and pressure into force_; a non-null `motion`
     /// lets the solver move the particles as it goes (StepState::motion).
-    void accumulateForces(BlockMotion* motion = nullptr);
+    /// Also measures failureApproachRate() at x^n into *approachRate where that is not null
+    /// (approachInPass()).
+    void accumulateForces(BlockMotion* motion = nullptr, double* approachRate = nullptr);
+    FailureApproach failureApproach() const;
+    /// Whether advanceTo chooses a step after its force pass, which then measures the last
+    /// step's failure approach rate (Solver::measuresApproachInPass).
+    bool approachInPass() const;
+    /// The controller's record of the last step, with its failure approach rate.
+    void recordStep(double failureRate);
     void addPressure(std::vector<Eigen::Vector3d>& force) const;
     void stepSymplecticEuler();
     void stepVelocityVerlet();
@@ -278,6 +293,17 @@ private:
     std::vector<double> theta_;             ///< diffusive quantity; empty without diffusion
     std::vector<double> damage_;            ///< per particle; empty unless canDamage_
     bool kickInPass_ = true, keptKickInPass_ = false;
+    bool approachInPass_ = true;
+    long approachesInPass_ = 0;
+    /// advanceTo's last step, not yet recorded: the next step's pass measures its failure
+    /// approach rate, or a pass of its own at the frame's end.
+    struct UnrecordedStep {
+        double taken = 0.0;
+        std::size_t broken = 0;
+    };
+    std::optional<UnrecordedStep> unrecorded_;
+    /// advanceTo's choice of the step's length, made after the force pass (approachInPass()).
+    const std::function<void()>* chooseAfterForces_ = nullptr;
     bool forcesCurrent_ = false;  ///< force_ holds the forces of the current x (Verlet reuses them)
     /// At least every particle's |v| since the last check (StepState::speedBound), or -1 once v
     /// may have changed: the guard's largest free speed, and the boundaries' speeds.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -62,6 +63,10 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
             const unsigned bit = unsigned(u) % kPairTile;
             std::uint8_t& row = over[u / kPairTile];
             row = std::uint8_t((bit == 0 ? 0u : row & ~(1u << bit)) | unsigned(past) << bit);
+            if (out.approaching) {  // every pair: flaggedApproachRate's exact test decides
+                std::uint8_t& near = out.approaching[u / kPairTile];
+                near = std::uint8_t((bit == 0 ? 0u : near) | 1u << bit);
+            }
         }
         if constexpr (kLaw == BondLawKind::PowerLaw) {  // eq. 19, and the tangent in dt
             if (kUpdate && eta < 0.0 && !past && i >= in.ownBegin && in.alive[in.upper[u]]) {
@@ -490,6 +495,24 @@ double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int be
                          : avx2::approachSimd<false>(in, a, begin, end, fastest);
 #endif
     for (int u = begin; u < end; ++u) fastest = std::max(fastest, approachOf(in, a, u));
+    return fastest;
+}
+
+double flaggedApproachRate(const LinearPairInput& in, const ApproachRate& a,
+                           const std::uint8_t* approaching, int begin, int end) {
+    double fastest = 0.0;
+    for (int row = begin / kPairTile; row * kPairTile < end; ++row) {
+        std::uint64_t eight = 0;  // 64 pairs at once where none is flagged
+        if ((row + 8) * kPairTile <= end &&
+            (std::memcpy(&eight, &approaching[row], 8), eight == 0)) {
+            row += 7;
+            continue;
+        }
+        for (unsigned bits = approaching[row]; bits != 0; bits &= bits - 1) {
+            const int u = kPairTile * row + std::countr_zero(bits);
+            if (u >= begin && u < end) fastest = std::max(fastest, approachOf(in, a, u));
+        }
+    }
     return fastest;
 }
 

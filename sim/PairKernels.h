@@ -92,6 +92,16 @@ inline int slotStride(bool rows) { return rows ? kPairTile : 1; }
 /// Whether the slots are in rows: the width is 4 or 8.
 bool slotRows();
 
+/// Membrane::failureApproachRate's measure: how fast the pairs loaded past half their critical
+/// stretch approach it, ds/dt over the margin left (at least delta eta_c).
+struct ApproachRate {
+    double critical = 0.0;  ///< eta_c: the membrane's, without maps
+    double expansion = 0.0, strengthLoss = 0.0;
+    double delta = 0.0;                 ///< time.max_stretch_increment
+    const std::uint8_t* pad = nullptr;  ///< per pair: a tile's repeat (not counted)
+    int ownBegin = 0, ownEnd = 0;       ///< the pairs counted: their first end in this range
+};
+
 struct LinearPairOutput {
     /// Pair u's force on i at slotAt(u - slotBase, rows), or, with rowSlot, x at
     /// rowSlot[u / kPairTile] + u % kPairTile and y, z `stride` and twice that after: zero past
@@ -100,6 +110,12 @@ struct LinearPairOutput {
     /// Per row of kPairTile pairs (only with a limit): bit u % kPairTile of byte u / kPairTile,
     /// pair u is past its limit. The kernels take rows whole: begin is a multiple of kPairTile.
     std::uint8_t* over = nullptr;
+    /// With a limit, where not null: per row, as over, bit u % kPairTile set where pair u may
+    /// count in Membrane::failureApproachRate by `approach` (the kernels: exactly where its
+    /// screen, loaded past half eta_c, holds; one pair at a time: every pair), for
+    /// flaggedApproachRate().
+    std::uint8_t* approaching = nullptr;
+    const ApproachRate* approach = nullptr;
     int slotBase = 0;
     bool rows = false;  ///< slotRows()
     /// In rows, per row of kPairTile pairs: where its lane 0's x lies (PeridynamicBonds lays a
@@ -118,20 +134,15 @@ struct LinearPairOutput {
     int* nearRows = nullptr;
 };
 
-/// Membrane::failureApproachRate's measure: how fast the pairs loaded past half their critical
-/// stretch approach it, ds/dt over the margin left (at least delta eta_c).
-struct ApproachRate {
-    double critical = 0.0;  ///< eta_c: the membrane's, without maps
-    double expansion = 0.0, strengthLoss = 0.0;
-    double delta = 0.0;                 ///< time.max_stretch_increment
-    const std::uint8_t* pad = nullptr;  ///< per pair: a tile's repeat (not counted)
-    int ownBegin = 0, ownEnd = 0;       ///< the pairs counted: their first end in this range
-};
-
 /// The largest rate over pairs [begin, end) that live (in.alive of their upper copy), are not
 /// pads and whose first end is owned; 0 if none. The bits of Membrane's loop over bonds, term by
 /// term (in.x, in.v, in.theta, in.restLength or its classes).
 double pairApproachRate(const LinearPairInput& in, const ApproachRate& a, int begin, int end);
+/// The same over the pairs of [begin, end) whose bit is set in `approaching`
+/// (LinearPairOutput::approaching, from the pairs' forces at the same x, theta and flags): the
+/// same value, one pair at a time where the pass flagged one.
+double flaggedApproachRate(const LinearPairInput& in, const ApproachRate& a,
+                           const std::uint8_t* approaching, int begin, int end);
 
 /// The largest |p[k]| of n values, simdWidth() lanes at a time (a NaN may be left out).
 double largestMagnitude(const double* p, std::size_t n);

@@ -598,13 +598,27 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
     work.slots.resize(ringSize * teams);
     if (kUpdateBonds && movingMotion(s))
         work.blockForce.resize(3 * std::size_t(kFusedBlock) * teams);
-    if (kBreak) work.over.resize((pairFirst_.size() + kPairTile - 1) / kPairTile);
+    const std::size_t rowCount = (pairFirst_.size() + kPairTile - 1) / kPairTile;
+    if (kBreak) work.over.resize(rowCount);
     const LinearPairInput in = pairInput(s, kUpdateBonds, kBreak);
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
     // As the scalar loop's; a reduction's private copies start from the lowest double.
     const double needed = std::max(1.0, s.stiffeningNeeded);
     double stiffest = needed;
+    // Membrane::failureApproachRate at the step's start, asked for by an adaptive step whose
+    // length waits for it: each block's pairs measured just after its forces, in cache, instead
+    // of in a pass of their own (no motion, so x and v are the step's start). A maximum: the
+    // same for any thread count and order.
+    // The kernels flag the pairs loaded past half eta_c as they compute their forces (their
+    // screen's bits), so only those are measured (the shipped foil at final quality: a pass of
+    // its own took 14% of a run's samples, measuring every pair in cache after the kernel 12%).
+    std::optional<std::pair<LinearPairInput, ApproachRate>> approach;
+    if (kUpdateBonds && kBreak && s.approach && !s.motion && !s.v.empty()) {
+        approach = approachInput(s, *s.approach);
+        work.approaching.resize(rowCount);
+    }
+    double fastestApproach = 0.0;
     // Each thread takes a run of particles and, block by block, computes their pairs into its
     // own ring of slots and at once sums them into the block's particles, while the slots are
     // in cache (a ring, so that they never go to memory). A particle's lower copies reach back
@@ -652,7 +666,10 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                 const int base = u - int(unsigned(u) & (ringPairs_ - 1));
                 const int stop = std::min(end, base + ringPairs_);
                 input.stiffestKnown = most;
-                LinearPairOutput out{ring, work.over.data(), base, rows};
+                LinearPairOutput out{ring, work.over.data()};
+                out.slotBase = base, out.rows = rows;
+                if (approach && &input == &own)
+                    out.approaching = work.approaching.data(), out.approach = &approach->second;
                 if (rows) out.rowSlot = rowSlot_.data(), out.stride = rowStride_;
                 out.nearRows = &near;
                 most = std::max(most, linearPairForces(input, out, u, stop));
@@ -662,6 +679,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             return most;
         };
         compute(ghosts, tileStart(std::max(slab_.ghostBegin, from - reach_)), from);
+        double approaching = 0.0;  // the flagged pairs of the thread's blocks
 #pragma omp barrier
         PairGather gather{bonds_.offsets.data(),
                           pairs_.upperBegin.data(),
@@ -697,6 +715,11 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             // particles, power law: 3.2% of the samples in this loop's own code, then 0.4%).
             __builtin_prefetch(&tileBegin_[std::min(q + 2 * kFusedBlock, n) / kTile]);
             stiffest = std::max(stiffest, compute(own, p, q));
+            if (approach)
+                approaching =
+                    std::max(approaching, flaggedApproachRate(approach->first, approach->second,
+                                                              work.approaching.data(),
+                                                              pairsBefore(p), pairsBefore(q)));
             const int first = std::max(p, slab_.begin);
             const bool inBlock = motion && first >= settled;
             gather.force = inBlock ? ownBlock : forceArray;
@@ -713,7 +736,10 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
 #pragma omp barrier
             moveRange(*motion, std::max(from, slab_.begin), settled);
         }
+#pragma omp critical(rend_approach)
+        fastestApproach = std::max(fastestApproach, approaching);
     });
+    if (approach) *s.approachRate = fastestApproach;
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
     updates.stiffest = stiffest;
 }
@@ -792,15 +818,20 @@ void PeridynamicBonds::advance(const StepState& s, Workspace& work,
     if (law_.kind == BondLawKind::PowerLaw) stiffening_ = updates.stiffest;
 }
 
+std::pair<LinearPairInput, ApproachRate> PeridynamicBonds::approachInput(
+    const StepState& s, const FailureApproach& f) const {
+    LinearPairInput in = pairInput(s, false, false);
+    in.v = s.v.data()->data();
+    return {in, ApproachRate{f.criticalStretch, f.expansion, f.strengthLoss, f.maxStretchIncrement,
+                             pairPad_.data(), slab_.begin, slab_.end}};
+}
+
 // The vectorised pass's pairs, each bond once through its upper copy, as Membrane's loop takes
 // them (j > i, living, i this process's).
 std::optional<double> PeridynamicBonds::failureApproachRate(const StepState& s,
                                                             const FailureApproach& f) const {
     if (!vectorised() || s.v.empty()) return std::nullopt;
-    LinearPairInput in = pairInput(s, false, false);
-    in.v = s.v.data()->data();
-    const ApproachRate a{f.criticalStretch, f.expansion, f.strengthLoss, f.maxStretchIncrement,
-                         pairPad_.data(),   slab_.begin, slab_.end};
+    const auto [in, a] = approachInput(s, f);
     const int n = bonds_.particleCount(), first = pairsBefore(tileStart(slab_.begin));
     const int last = pairsBefore(slab_.end);
     double fastest = 0.0;  // a maximum: the same for any thread count

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "sim/BondLaw.h"
@@ -27,6 +28,7 @@
 namespace rend::sim {
 
 struct LinearPairInput;  // sim/PairKernels.h
+struct ApproachRate;     // sim/PairKernels.h
 
 class PeridynamicBonds final : public Solver {
 public:
@@ -67,6 +69,10 @@ public:
     void reportStrength(DamageState& damage) const override;
     std::optional<double> failureApproachRate(const StepState& s,
                                               const FailureApproach& f) const override;
+    /// The linear and elastoplastic laws' passes (the power law's look-ahead reads dt).
+    bool measuresApproachInPass() const override {
+        return vectorised() && law_.kind != BondLawKind::PowerLaw;
+    }
     bool restrictTo(const Slab& slab) override {
         slab_ = slab;
         return true;
@@ -117,6 +123,7 @@ private:
         std::vector<Eigen::Vector3d> pairForce;
         std::vector<double> slots;       ///< the vectorised laws': a ring of slots per thread
         std::vector<std::uint8_t> over;  ///< a bit per pair (LinearPairOutput::over)
+        std::vector<std::uint8_t> approaching;  ///< LinearPairOutput::approaching
         std::vector<double> blockForce;  ///< a fused block's forces per thread, where it moves them
     };
     /// The kernel's view of this step: the pair arrays, x, theta and the law's constants.
@@ -134,6 +141,9 @@ private:
     /// power law with a whole exponent and the elastoplastic law, without maps of their own
     /// parameters.
     bool vectorised() const;
+    /// failureApproachRate's pairs and constants.
+    std::pair<LinearPairInput, ApproachRate> approachInput(const StepState& s,
+                                                           const FailureApproach& f) const;
     int proposeBreaks(const std::vector<std::uint8_t>& over, std::uint8_t* proposed) const;
     double strainEnergyOf(const StepState& s, int begin, int end) const;
     /// The force loop for the scene's law.

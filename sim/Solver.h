@@ -47,6 +47,8 @@ public:
     virtual void move(int begin, int end, const double* block, int first) = 0;
 };
 
+struct FailureApproach;
+
 /// One step's state, passed explicitly.
 struct StepState {
     std::span<const Eigen::Vector3d> x;  ///< positions
@@ -62,6 +64,10 @@ struct StepState {
     /// Non-null: advance() may move the particles through it instead of leaving that to the
     /// caller (the caller asks the motion whether it moved them). forces() never does.
     BlockMotion* motion = nullptr;
+    /// Non-null (advance() only, where the solver measuresApproachInPass() and motion is null):
+    /// the pass also writes failureApproachRate(s, *approach) into *approachRate, the same bits.
+    const FailureApproach* approach = nullptr;
+    double* approachRate = nullptr;
 };
 
 /// What Membrane::failureApproachRate measures a step by (its constants).
@@ -136,6 +142,11 @@ public:
                                                       const FailureApproach& f) const {
         return std::nullopt;
     }
+    /// Whether advance() measures failureApproachRate in its own pass (StepState::approach) and
+    /// reads neither StepState::dt nor StepState::speedBound: an adaptive step may then be
+    /// chosen after the pass, from the rate that pass measured at the step's start (Membrane::
+    /// advanceTo). No by default.
+    virtual bool measuresApproachInPass() const { return false; }
     /// The solver's own history (plastic strains, broken pieces) for a checkpoint
     /// (sim/StateArchive.h), read back into a solver built from the same scene. Nothing by
     /// default: a solver without history keeps it all in the DamageState.

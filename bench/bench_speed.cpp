@@ -14,7 +14,10 @@
 // elastoplastic laws again with the kick and drift in their own pass after the forces
 // (Membrane::setKickInPass(false), the order until 2026-11-27): what the change saves. And the
 // diffusion alone (eq. 25, Diffusion::advance) of the linear law's crack_path_sources sheets,
-// after their steps: ns per particle-step on 1 thread.
+// after their steps: ns per particle-step on 1 thread. Last, crack_path_sources as shipped
+// (hexagonal, adaptive steps, frame by frame) for the linear and elastoplastic laws, with the
+// adaptive step's failure approach rate measured in the next step's force pass and in a pass of
+// its own (Membrane::setApproachInPass(false)): what that saves.
 //
 // Every rend figure is the fastest of five spans of its steps, and the one-thread rows and
 // LAMMPS run pinned to one core, the fastest of the usable ones by a dependent add loop at the
@@ -279,6 +282,43 @@ double lawRow(const std::string& scene, const char* law, double side = 0.0, int 
     return ns;
 }
 
+/// ns per particle-step on 1 thread of crack_path_sources as shipped (its hexagonal lattice,
+/// time.dt = "adaptive") with [material] law = `law`, stepped frame by frame (Membrane::advanceTo)
+/// with the failure approach rate measured in the next step's force pass, and in a pass of its
+/// own after every step (Membrane::setApproachInPass(false), the order until 2026-11-29): two
+/// membranes advanced through the same frames, in alternate spans of 12 frames after 24, the
+/// fastest span of five each. The same steps and bits: what the change saves.
+std::array<double, 2> adaptiveRow(const char* law) {
+    const rend::Scene s =
+        rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/crack_path_sources.toml",
+                        {std::string("material.law=\"") + law + "\""});
+    rend::sim::Membrane inPass(s.sim), ownPass(s.sim);
+    ownPass.setApproachInPass(false);
+    const PinnedThread pin(gOneCore);
+    omp_set_num_threads(1);
+    const double frame = 1.0 / s.sim.time.fps;
+    int frames = 0;
+    const auto advance = [&](rend::sim::Membrane& m, int count) {
+        for (int f = 1; f <= count; ++f) m.advanceTo((frames + f) * frame);
+    };
+    advance(inPass, 24), advance(ownPass, 24), frames = 24;
+    std::array<double, 2> fastest{std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::infinity()};
+    for (int span = 0; span < 5; ++span, frames += 12) {
+        int k = 0;
+        for (rend::sim::Membrane* m : {&inPass, &ownPass}) {
+            const long before = m->stepCount();
+            const Clock::time_point start = Clock::now();
+            advance(*m, 12);
+            const double steps = double(m->stepCount() - before);
+            fastest[k] =
+                std::min(fastest[k], secondsSince(start) * 1e9 / steps / m->particleCount());
+            ++k;
+        }
+    }
+    return fastest;
+}
+
 /// A figure of rend's with LAMMPS's runs just before and after it on the same core (gOneCore),
 /// the faster of the two: this VM's cores slow down for minutes at a time, so a ratio means
 /// something only between runs seconds apart. lammps is negative without them.
@@ -434,6 +474,16 @@ int main(int argc, char** argv) {
     std::printf("%-32s %*s", "diffusion alone (linear's)", widths[0], "-");
     for (int c = 1; c < columns; ++c) std::printf(" %*.1f", widths[c], diffusion[c]);
     std::printf("\n");
+    std::printf(
+        "\nns per particle-step, 1 thread, crack_path_sources as shipped (hexagonal, 11,658 "
+        "particles, adaptive steps, frame by frame), its failure approach rate measured\n%-32s "
+        "%18s %18s %10s\n",
+        "law", "in the force pass", "in its own pass", "saved");
+    for (const char* law : {kLaws[0], kLaws[2]}) {
+        const std::array<double, 2> ns = adaptiveRow(law);
+        std::printf("%-32s %18.1f %18.1f %9.0f%%\n", law, ns[0], ns[1],
+                    100.0 * (1.0 - ns[0] / ns[1]));
+    }
     if (!lmp) return 0;
     std::printf(
         "\nthe same as times faster than LAMMPS peri/pmb (10,201 particles) run on the same core "

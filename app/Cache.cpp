@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 
 #include "render/AtomicFile.h"
 
@@ -56,16 +57,34 @@ std::array<unsigned char, kHeaderBytes> encode(const Header& h) {
     return out;
 }
 
-/// Groups byte k of every 8-byte word together (the tail, shorter than a word, stays as it is).
-std::vector<std::byte> shuffled(std::span<const std::byte> in) {
-    std::vector<std::byte> out(in.size());
+/// Groups byte k of every 8-byte word together (the tail, shorter than a word, stays as it is),
+/// into out[0, in.size()).
+void shuffle(std::span<const std::byte> in, std::byte* out) {
     const std::size_t words = in.size() / kShuffle;
     for (std::size_t w = 0; w < words; ++w)
         for (std::size_t k = 0; k < kShuffle; ++k) out[k * words + w] = in[w * kShuffle + k];
-    std::copy(in.begin() + std::ptrdiff_t(words * kShuffle), in.end(),
-              out.begin() + std::ptrdiff_t(words * kShuffle));
-    return out;
+    std::copy(in.begin() + std::ptrdiff_t(words * kShuffle), in.end(), out + words * kShuffle);
 }
+
+/// A buffer kept between frames, grown but never filled: a frame's tens of megabytes allocated
+/// afresh were zeroed page by page by the kernel, and the compressor's bound zeroed again by
+/// std::string (the shipped foil at final quality: 8% of a run's samples).
+struct Scratch {
+    std::unique_ptr<std::byte[]> data;
+    std::size_t size = 0;
+    std::byte* atLeast(std::size_t n) {
+        if (n > size) data = std::make_unique_for_overwrite<std::byte[]>(n), size = n;
+        return data.get();
+    }
+    /// After a write: kept up to kCacheBufferKept.
+    void settle() {
+        if (size > kCacheBufferKept) data.reset(), size = 0;
+    }
+};
+
+struct ContextFree {
+    void operator()(ZSTD_CCtx* context) const { ZSTD_freeCCtx(context); }
+};
 
 std::vector<std::byte> unshuffled(std::span<const std::byte> in) {
     std::vector<std::byte> out(in.size());
@@ -93,15 +112,18 @@ std::string cacheFileName(int frame) {
 
 std::uintmax_t writeCacheFrame(const std::filesystem::path& outDir, const CacheFrame& frame,
                                int compressionLevel) {
-    const std::vector<std::byte> plain = shuffled(frame.state);
-    std::string bytes(kHeaderBytes + ZSTD_compressBound(plain.size()), '\0');
-    ZSTD_CCtx* context = ZSTD_createCCtx();
-    ZSTD_CCtx_setParameter(context, ZSTD_c_compressionLevel, compressionLevel);
-    ZSTD_CCtx_setParameter(context, ZSTD_c_checksumFlag, 1);
+    thread_local Scratch plain, packed;
+    thread_local std::unique_ptr<ZSTD_CCtx, ContextFree> context{ZSTD_createCCtx()};
+    if (!context) throw std::runtime_error("zstd: cannot create a compression context");
+    const std::size_t size = frame.state.size();
+    shuffle(frame.state, plain.atLeast(size));
+    const std::size_t bound = ZSTD_compressBound(size);
+    std::byte* const bytes = packed.atLeast(kHeaderBytes + bound);
+    ZSTD_CCtx_reset(context.get(), ZSTD_reset_session_and_parameters);
+    ZSTD_CCtx_setParameter(context.get(), ZSTD_c_compressionLevel, compressionLevel);
+    ZSTD_CCtx_setParameter(context.get(), ZSTD_c_checksumFlag, 1);
     const std::size_t compressed =
-        ZSTD_compress2(context, bytes.data() + kHeaderBytes, bytes.size() - kHeaderBytes,
-                       plain.data(), plain.size());
-    ZSTD_freeCCtx(context);
+        ZSTD_compress2(context.get(), bytes + kHeaderBytes, bound, plain.data.get(), size);
     if (ZSTD_isError(compressed))
         throw std::runtime_error("zstd: " + std::string(ZSTD_getErrorName(compressed)));
     Header h;
@@ -112,12 +134,14 @@ std::uintmax_t writeCacheFrame(const std::filesystem::path& outDir, const CacheF
     h.stateBytes = frame.state.size();
     h.compressedBytes = compressed;
     const auto header = encode(h);
-    std::memcpy(bytes.data(), header.data(), kHeaderBytes);
-    bytes.resize(kHeaderBytes + compressed);
+    std::memcpy(bytes, header.data(), kHeaderBytes);
     const std::filesystem::path path = outDir / cacheFileName(frame.frame);
     std::filesystem::create_directories(path.parent_path());
-    render::writeFileAtomic(path, bytes);
-    return bytes.size();
+    plain.settle();
+    render::writeFileAtomic(path,
+                            {reinterpret_cast<const char*>(bytes), kHeaderBytes + compressed});
+    packed.settle();
+    return kHeaderBytes + compressed;
 }
 
 CacheFrame readCacheFrame(const std::filesystem::path& file) {

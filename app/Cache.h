@@ -47,6 +47,11 @@ inline constexpr const char* kCacheSourceName = "cache/source.toml";
 /// "cache/frame_0007.rcache", relative to the output folder.
 std::string cacheFileName(int frame);
 
+/// The largest buffer a run keeps from one cached frame to the next (its state, shuffled and
+/// compressed), so that it is not allocated, and its pages zeroed, again; larger ones are freed
+/// after each write, so a huge sheet holds no copies of its state while it renders.
+inline constexpr std::size_t kCacheBufferKept = std::size_t(256) << 20;
+
 /// Writes `frame` atomically under outDir / cacheFileName(frame.frame); returns its size in
 /// bytes. Throws std::system_error naming the file (a full disk).
 std::uintmax_t writeCacheFrame(const std::filesystem::path& outDir, const CacheFrame& frame,

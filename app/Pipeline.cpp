@@ -539,12 +539,16 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         }
     };
     // After the frame's pictures, so a cached frame's files are all complete (--resume).
+    std::vector<std::byte> stateKept;
     auto cacheFrame = [&](int frame) {
         if (options.cacheEvery <= 0 || frame % options.cacheEvery != 0) return;
         const auto started = Clock::now();
-        s.cacheBytes += writeCacheFrame(
-            options.outDir, {frame, membrane.time(), scene.simulationFingerprint,
-                             std::uint64_t(membrane.particleCount()), membrane.saveState()});
+        // The state written into the last frame's storage (Membrane::saveState's `reuse`).
+        CacheFrame cached{frame, membrane.time(), scene.simulationFingerprint,
+                          std::uint64_t(membrane.particleCount()),
+                          membrane.saveState(std::move(stateKept))};
+        s.cacheBytes += writeCacheFrame(options.outDir, cached);
+        if (cached.state.capacity() <= kCacheBufferKept) stateKept = std::move(cached.state);
         folder.wrote({cacheFileName(frame)});
         ++s.framesCached;
         s.seconds.cache += secondsSince(started);

@@ -119,8 +119,9 @@ public:
 
     /// The evolving state, for a checkpoint (sim/StateArchive.h): read back with loadState
     /// into a membrane built from the same scene, it steps on with the same bits. Taken
-    /// between frames (after startFrame's frame ends, before the next one starts).
-    std::vector<std::byte> saveState() const;
+    /// between frames (after startFrame's frame ends, before the next one starts). Written into
+    /// `reuse`'s storage where given (a caller saving every frame keeps its pages).
+    std::vector<std::byte> saveState(std::vector<std::byte> reuse = {}) const;
     /// Throws StateMismatch when `bytes` do not fit this membrane (another scene, truncated).
     void loadState(std::span<const std::byte> bytes);
 

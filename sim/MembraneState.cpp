@@ -42,8 +42,8 @@ void Membrane::visitState(Self& m, Archive& a) {
     }
 }
 
-std::vector<std::byte> Membrane::saveState() const {
-    StateWriter out;
+std::vector<std::byte> Membrane::saveState(std::vector<std::byte> reuse) const {
+    StateWriter out(std::move(reuse));
     visitState(*this, out);
     solver_->saveState(out);
     return out.take();

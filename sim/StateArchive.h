@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace rend::sim {
@@ -41,6 +42,11 @@ inline constexpr bool kRaw = std::is_trivially_copyable_v<T> || IsFixedEigen<T>:
 
 class StateWriter {
 public:
+    /// Writes into `reuse`'s storage (emptied first): a caller that saves every frame keeps its
+    /// pages, rather than growing a new buffer through every size up to the state's.
+    explicit StateWriter(std::vector<std::byte> reuse = {}) : bytes_(std::move(reuse)) {
+        bytes_.clear();
+    }
     template <class T>
     requires detail::kRaw<T>
     void operator()(const T& value) { append(&value, sizeof(T)); }

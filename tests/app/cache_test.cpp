@@ -72,6 +72,23 @@ TEST(Cache, AFrameReadsBackBitForBitAndCompressed) {
     EXPECT_EQ(cacheFileName(7), "cache/frame_0007.rcache");
 }
 
+// The buffers a run keeps between frames (kCacheBufferKept): a smaller state after a larger one,
+// then a larger again, each reads back as written, with the bytes a first write of it gives.
+TEST(Cache, FramesWrittenOneAfterAnotherReadBackAsWrittenAlone) {
+    const fs::path dir = freshDir("rend_cache_sequence"), alone = freshDir("rend_cache_alone");
+    CacheFrame large = sampleFrame(1), small = sampleFrame(2), larger = sampleFrame(3);
+    small.state.resize(small.state.size() / 3);
+    larger.state.insert(larger.state.end(), large.state.begin(), large.state.end());
+    for (const CacheFrame* f : {&large, &small, &larger}) writeCacheFrame(dir, *f);
+    for (const CacheFrame* f : {&large, &small, &larger}) {
+        EXPECT_EQ(readCacheFrameFor(dir, f->frame, 0x1234abcdULL, 1000).state, f->state)
+            << "frame " << f->frame;
+        writeCacheFrame(alone, *f);
+        EXPECT_EQ(slurp(dir / cacheFileName(f->frame)), slurp(alone / cacheFileName(f->frame)))
+            << "frame " << f->frame << ": the same file as written alone";
+    }
+}
+
 TEST(Cache, DamagedTruncatedAndForeignFilesAreRefusedByName) {
     const fs::path dir = freshDir("rend_cache_damage");
     writeCacheFrame(dir, sampleFrame(3));

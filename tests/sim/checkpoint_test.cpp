@@ -118,6 +118,9 @@ std::size_t expectResumedRunMatches(const MembraneParams& p, int frames, int at,
     if (prepare) prepare(straight);
     runFrames(straight, 1, at, frameTime, fixedSteps);
     const std::vector<std::byte> checkpoint = straight.saveState();
+    // Written into a last frame's storage (longer, and not empty), the same bytes.
+    EXPECT_EQ(straight.saveState(std::vector<std::byte>(checkpoint.size() + 99, std::byte{7})),
+              checkpoint);
     runFrames(straight, at + 1, frames, frameTime, fixedSteps);
 
     Membrane resumed(p);

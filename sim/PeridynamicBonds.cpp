@@ -831,7 +831,9 @@ std::pair<LinearPairInput, ApproachRate> PeridynamicBonds::approachInput(
 std::optional<double> PeridynamicBonds::failureApproachRate(const StepState& s,
                                                             const FailureApproach& f) const {
     if (!vectorised() || s.v.empty()) return std::nullopt;
-    const auto [in, a] = approachInput(s, f);
+    const std::pair<LinearPairInput, ApproachRate> input = approachInput(s, f);
+    const LinearPairInput& in = input.first;  // named: a lambda below reads them
+    const ApproachRate& a = input.second;
     const int n = bonds_.particleCount(), first = pairsBefore(tileStart(slab_.begin));
     const int last = pairsBefore(slab_.end);
     double fastest = 0.0;  // a maximum: the same for any thread count

@@ -7,12 +7,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
 
 #include "app/Cache.h"
+#include "app/CacheWriter.h"
 #include "app/FrameWriter.h"
 #include "app/MpiDomain.h"
 #include "app/Outputs.h"
@@ -538,19 +540,27 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
         } catch (const std::exception&) {
         }
     };
-    // After the frame's pictures, so a cached frame's files are all complete (--resume).
-    std::vector<std::byte> stateKept;
+    // After the frame's pictures, so a cached frame's files are all complete (--resume). The
+    // write goes on while the next frame simulates (app/CacheWriter.h); s.seconds.cache is what
+    // the run waited for it, the state's copy included.
+    CacheWriter cacheWriter(options.outDir);
     auto cacheFrame = [&](int frame) {
         if (options.cacheEvery <= 0 || frame % options.cacheEvery != 0) return;
         const auto started = Clock::now();
         // The state written into the last frame's storage (Membrane::saveState's `reuse`).
-        CacheFrame cached{frame, membrane.time(), scene.simulationFingerprint,
-                          std::uint64_t(membrane.particleCount()),
-                          membrane.saveState(std::move(stateKept))};
-        s.cacheBytes += writeCacheFrame(options.outDir, cached);
-        if (cached.state.capacity() <= kCacheBufferKept) stateKept = std::move(cached.state);
-        folder.wrote({cacheFileName(frame)});
-        ++s.framesCached;
+        cacheWriter.start({frame, membrane.time(), scene.simulationFingerprint,
+                           std::uint64_t(membrane.particleCount()),
+                           membrane.saveState(cacheWriter.takeStorage())});
+        s.seconds.cache += secondsSince(started);
+    };
+    // Before anything of the next frame is written, and before the run ends.
+    auto cacheWritten = [&] {
+        const auto started = Clock::now();
+        if (const auto written = cacheWriter.wait()) {
+            s.cacheBytes += written->bytes;
+            folder.wrote({cacheFileName(written->frame)});
+            ++s.framesCached;
+        }
         s.seconds.cache += secondsSince(started);
     };
     std::vector<std::string> frameFiles;  // the current frame's, as they are completed
@@ -567,6 +577,7 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
                 for (int k = 0; k < substeps; ++k) membrane.step();
             membrane.gatherToFirst();  // the whole sheet, from every process's slab
             s.seconds.simulate += secondsSince(t0);
+            cacheWritten();
             s.framesSimulated = frame;
             const StatsWriter::Row row = frameStats(frame, membrane);  // checks it is finite
             if (stats) stats->append(row);
@@ -581,17 +592,30 @@ RunSummary runScene(const Scene& scene, const RunOptions& options) {
             cacheFrame(frame);
             progress.frameDone(frame, membrane.time(), frameFiles.empty() ? "" : frameFiles[0]);
         }
+        cacheWritten();
         s.framesSimulated = std::max(s.framesSimulated, resumedAfter);
         finish("ok");
     } catch (const sim::NumericalBlowUp& e) {
+        try {
+            cacheWritten();  // the last frame's write failed first: that is the run's failure
+        } catch (...) {
+            finishAfterFailure();
+            throw;
+        }
         finish("blow-up");
         // Located at the time step, the value the advice is about.
         throw sim::NumericalBlowUp(scene.locationOf("time.dt") + ": error: " + e.what(), e.step,
                                    e.particle, e.suggestedDt);
     } catch (...) {
         folder.wrote(frameFiles);
+        std::exception_ptr failure = std::current_exception();
+        try {
+            cacheWritten();
+        } catch (...) {
+            failure = std::current_exception();  // the earlier failure
+        }
         finishAfterFailure();
-        throw;
+        std::rethrow_exception(failure);
     }
     return s;
 }

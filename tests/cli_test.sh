@@ -234,6 +234,14 @@ check "full disk names the OBJ" grep -q "cannot write $tmp/fullobj/meshes/frame_
 check "full disk leaves no OBJ nor its MTL" test ! -e "$tmp/fullobj/meshes/frame_0001.obj" -a ! -e "$tmp/fullobj/meshes/frame_0001.mtl"
 check "full disk lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['cache/source.toml','frames/frame_0001.png','meshes/frame_0001.ply','stats.csv'], f" "$tmp/fullobj/run.json"
 check "full disk keeps the frames before the failure whole" pngs_complete "$tmp/fullobj"
+# The cache's writes overlap the next frame's simulation (app/CacheWriter.h), but the run waits for
+# one before it writes anything of the next frame: it stops where a write of its own stopped.
+check "full disk at a cache file exits 1" full_disk 16 scenes/stretch.toml "${small[@]}" --out "$tmp/fullcache" \
+    --set render.width=48 --set render.height=27
+check "full disk at a cache file names it" grep -q "cannot write $tmp/fullcache/cache/frame_0001.rcache: File too large" "$tmp/stderr"
+check "full disk at a cache file lists what was written" python3 -c "import json,sys; f=json.load(open(sys.argv[1]))['files']; assert f==['cache/source.toml','frames/frame_0001.png','stats.csv'], f" "$tmp/fullcache/run.json"
+check "full disk at a cache file writes nothing of the next frame" test ! -e "$tmp/fullcache/frames/frame_0002.png" -a "$(wc -l <"$tmp/fullcache/stats.csv")" -eq 2
+check "full disk at a cache file leaves no partial files" no_partial_files "$tmp/fullcache"
 check "full disk at run.json exits 1" full_disk 1 scenes/stretch.toml "${small[@]}" --out "$tmp/fulljson"
 check "full disk at run.json writes nothing" test -z "$(find "$tmp/fulljson" -type f)"
 check "full disk at a VDB exits 1" full_disk 100 scenes/stretch.toml "${small[@]}" --out "$tmp/fullvdb" \

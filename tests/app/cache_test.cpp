@@ -8,7 +8,10 @@
 #include <fstream>
 #include <iterator>
 #include <random>
+#include <stdexcept>
+#include <system_error>
 
+#include "app/CacheWriter.h"
 #include "tests/ScratchDir.h"
 
 namespace fs = std::filesystem;
@@ -87,6 +90,55 @@ TEST(Cache, FramesWrittenOneAfterAnotherReadBackAsWrittenAlone) {
         EXPECT_EQ(slurp(dir / cacheFileName(f->frame)), slurp(alone / cacheFileName(f->frame)))
             << "frame " << f->frame << ": the same file as written alone";
     }
+}
+
+// The run's writes on a thread of their own (app/CacheWriter.h): the files of writeCacheFrame,
+// one write in flight at a time, and the state's storage handed back for the next frame.
+TEST(CacheWriter, WritesTheFilesOfTheRunsOwnWriteOneAtATime) {
+    const fs::path dir = freshDir("rend_cache_writer"), alone = freshDir("rend_cache_writer1");
+    CacheWriter writer(dir);
+    EXPECT_FALSE(writer.wait()) << "nothing in flight";
+    for (int frame = 1; frame <= 3; ++frame) {
+        const CacheFrame f = sampleFrame(frame);
+        writer.start(f);
+        if (frame == 2) {
+            EXPECT_THROW(writer.start(f), std::logic_error) << "one at a time";
+        }
+        const auto written = writer.wait();
+        ASSERT_TRUE(written);
+        EXPECT_EQ(written->frame, frame);
+        EXPECT_EQ(written->bytes, writeCacheFrame(alone, f));
+        EXPECT_EQ(slurp(dir / cacheFileName(frame)), slurp(alone / cacheFileName(frame)));
+        const std::vector<std::byte> storage = writer.takeStorage();
+        EXPECT_EQ(storage, f.state) << "the written state's storage comes back";
+        EXPECT_TRUE(writer.takeStorage().empty()) << "once";
+    }
+    EXPECT_FALSE(writer.wait());
+}
+
+// A write that fails (here its temporary name is taken by a folder) is rethrown by the wait
+// after it, naming the file; the writer goes on with the next frame, and a write nobody waits
+// for is finished before the writer is gone.
+TEST(CacheWriter, AFailedWriteIsRethrownByTheWaitAfterIt) {
+    const fs::path dir = freshDir("rend_cache_writer_fail");
+    fs::create_directories(dir / "cache/frame_0002.rcache.tmp/blocked");
+    {
+        CacheWriter writer(dir);
+        writer.start(sampleFrame(2));
+        try {
+            writer.wait();
+            FAIL() << "the write into a folder's name succeeded";
+        } catch (const std::system_error& e) {
+            EXPECT_NE(std::string(e.what()).find("frame_0002.rcache"), std::string::npos)
+                << e.what();
+        }
+        EXPECT_FALSE(fs::exists(dir / cacheFileName(2)));
+        EXPECT_FALSE(writer.wait()) << "the failure is reported once";
+        writer.start(sampleFrame(3));
+        ASSERT_TRUE(writer.wait());
+        writer.start(sampleFrame(4));
+    }
+    EXPECT_EQ(readCacheFrameFor(dir, 4, 0x1234abcdULL, 1000).state, sampleFrame(4).state);
 }
 
 TEST(Cache, DamagedTruncatedAndForeignFilesAreRefusedByName) {

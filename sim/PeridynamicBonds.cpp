@@ -858,7 +858,23 @@ double PeridynamicBonds::strainEnergy(const StepState& s, Workspace&) const {
     return strainEnergyOf(s, 0, bonds_.particleCount());
 }
 
+// In blocks of particles summed in order, so its bits are the same on any thread count: each
+// frame's stats row takes it, and on one thread it was 3% of a final-quality foil.
 double PeridynamicBonds::strainEnergyOf(const StepState& s, int begin, int end) const {
+    constexpr int kBlock = 8192;
+    const int blocks = (end - begin + kBlock - 1) / kBlock;
+    if (blocks <= 1) return blockStrainEnergy(s, begin, end);
+    std::vector<double> partial(std::size_t(blocks), 0.0);
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < blocks; ++k)
+        partial[std::size_t(k)] =
+            blockStrainEnergy(s, begin + k * kBlock, std::min(end, begin + (k + 1) * kBlock));
+    double sum = 0.0;
+    for (const double e : partial) sum += e;
+    return sum;
+}
+
+double PeridynamicBonds::blockStrainEnergy(const StepState& s, int begin, int end) const {
     const auto& x = s.x;
     double sum = 0.0;
     for (int i = begin; i < end; ++i)

@@ -146,6 +146,7 @@ private:
                                                            const FailureApproach& f) const;
     int proposeBreaks(const std::vector<std::uint8_t>& over, std::uint8_t* proposed) const;
     double strainEnergyOf(const StepState& s, int begin, int end) const;
+    double blockStrainEnergy(const StepState& s, int begin, int end) const;
     /// The force loop for the scene's law.
     template <bool kUpdateBonds>
     void bondForces(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force,

@@ -144,6 +144,37 @@ TEST(Bonds, ForceIsTheNegativeGradientOfStrainEnergy) {
     }
 }
 
+// Past 8,192 particles the strain energy is summed in blocks on every thread
+// (PeridynamicBonds::strainEnergyOf): still the force's potential at a particle of each block,
+// and the same bits on one thread and two.
+TEST(Bonds, TheStrainEnergyInBlocksIsTheForcesPotentialOnAnyThreadCount) {
+    Membrane m(smallSheet(LatticeKind::Hexagonal, 2.0));
+    ASSERT_GT(m.particleCount(), 8192 + 1000) << "two blocks";
+    for (int i = 0; i < m.particleCount(); ++i)
+        m.positions()[i] += Eigen::Vector3d(0.003 * std::sin(17.0 * i), 0.002 * std::cos(5.0 * i),
+                                            0.004 * std::sin(3.0 * i));
+    std::vector<Eigen::Vector3d> f;
+    m.computeForces(f);
+    const double h = 1e-7;
+    for (const int i : {5, 8191, 8192, 9000, m.particleCount() - 2}) {
+        for (int axis = 0; axis < 3; ++axis) {
+            m.positions()[i][axis] += h;
+            const double up = m.strainEnergy();
+            m.positions()[i][axis] -= 2 * h;
+            const double down = m.strainEnergy();
+            m.positions()[i][axis] += h;
+            EXPECT_NEAR(-(up - down) / (2 * h), f[i][axis], 1e-5 * f[i].norm() + 1e-10)
+                << "particle " << i << ", axis " << axis;
+        }
+    }
+    omp_set_num_threads(1);
+    const double one = m.strainEnergy();
+    omp_set_num_threads(2);
+    const double two = m.strainEnergy();
+    EXPECT_EQ(std::memcmp(&one, &two, sizeof one), 0) << one << " against " << two;
+    EXPECT_GT(one, 0.0);
+}
+
 TEST(Membrane, MomentumIsConservedWithoutBoundaryConditions) {
     Membrane m(smallSheet(LatticeKind::Hexagonal, 0.4));
     for (int i = 0; i < m.particleCount(); ++i)

@@ -53,9 +53,11 @@ std::string cacheFileName(int frame);
 inline constexpr std::size_t kCacheBufferKept = std::size_t(256) << 20;
 
 /// Writes `frame` atomically under outDir / cacheFileName(frame.frame); returns its size in
-/// bytes. Throws std::system_error naming the file (a full disk).
+/// bytes. Throws std::system_error naming the file (a full disk). zstd's level 1: on the final
+/// foil's shuffled state 0.5% larger than level 3 and 1.5 times as fast (1,195 against 812 MB/s,
+/// `zstd -b1 -e3`).
 std::uintmax_t writeCacheFrame(const std::filesystem::path& outDir, const CacheFrame& frame,
-                               int compressionLevel = 3);
+                               int compressionLevel = 1);
 
 /// Reads and checks one cache file. Throws CacheError naming the file and the fault.
 CacheFrame readCacheFrame(const std::filesystem::path& file);

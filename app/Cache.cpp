@@ -16,7 +16,8 @@ namespace rend {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'E', 'N', 'D', 'C', 'A', 'C', 'H'};
-constexpr std::uint32_t kFormatVersion = 2;  // 2: the particle level set (issue 15)
+constexpr std::uint32_t kFormatVersion = 3;  // 2: the particle level set (issue 15); 3: the
+// elastoplastic history once per bond (sim/PeridynamicBonds.cpp)
 constexpr std::size_t kHeaderBytes = 64;
 constexpr std::size_t kShuffle = 8;
 

@@ -466,6 +466,56 @@ void PeridynamicBonds::bondForcesFor(const StepState& s, PairWorkspace& work,
     updates.stiffest = stiffest;
 }
 
+bool PeridynamicBonds::historyOncePerBond() const {
+    const int directed = int(plastic_.size());
+    for (int b = 0; b < directed; ++b)
+        if (std::memcmp(&plastic_[b], &plastic_[damage_->mirror(b)], sizeof(PlasticState)) != 0)
+            return false;
+    return true;
+}
+
+// The history is 8 bytes per directed bond: on the final foil (elastoplastic, 752K bonds) 12 of
+// the state's 43 MB, which both ends of a bond held twice.
+void PeridynamicBonds::saveState(StateWriter& out) const {
+    syncHistory();
+    const std::uint8_t once = !plastic_.empty() && historyOncePerBond();
+    out(once);
+    if (once) {
+        std::vector<int>& first = historyFirstEnds_;  // b < mirror(b), kept between frames
+        if (first.empty())
+            for (int b = 0; b < int(plastic_.size()); ++b)
+                if (b < damage_->mirror(b)) first.push_back(b);
+        out.vectorOf<PlasticState>(first.size(),
+                                   [&](std::uint64_t k) { return plastic_[first[k]]; });
+    } else {
+        out(plastic_);
+    }
+    out(stiffening_);
+}
+
+void PeridynamicBonds::loadState(StateReader& in) {
+    std::uint8_t once = 0;
+    in(once);
+    if (once) {
+        std::vector<PlasticState> perBond;
+        in(perBond);
+        std::size_t k = 0;
+        plastic_.resize(bonds_.directedCount());
+        for (int b = 0; b < int(plastic_.size()); ++b)
+            if (b < damage_->mirror(b)) {
+                if (k == perBond.size()) break;
+                plastic_[b] = plastic_[damage_->mirror(b)] = perBond[k++];
+            }
+        if (k != perBond.size() || 2 * k != plastic_.size())
+            throw StateMismatch("the state holds the history of " + std::to_string(perBond.size()) +
+                                " bonds, this scene " + std::to_string(plastic_.size() / 2));
+    } else {
+        in(plastic_);
+    }
+    in(stiffening_);
+    heldAhead_ = false, heldBehind_ = true;
+}
+
 void PeridynamicBonds::syncHistory() const {
     if (!heldAhead_) return;
     for (std::size_t u = 0; u < pairHeld_.size(); ++u)

@@ -58,14 +58,11 @@ public:
         int exact = 0, stepped = 0, perPair = 0;
     };
     RowClasses rowClasses() const;
-    void saveState(StateWriter& out) const override {
-        syncHistory();
-        out(plastic_), out(stiffening_);
-    }
-    void loadState(StateReader& in) override {
-        in(plastic_), in(stiffening_);
-        heldAhead_ = false, heldBehind_ = true;
-    }
+    /// The elastoplastic history once per bond, where both ends hold the same bits (they do: a
+    /// pair's strain is computed once, or from either end with the same operations), else per
+    /// directed bond; then the stiffening.
+    void saveState(StateWriter& out) const override;
+    void loadState(StateReader& in) override;
     void reportStrength(DamageState& damage) const override;
     std::optional<double> failureApproachRate(const StepState& s,
                                               const FailureApproach& f) const override;
@@ -147,6 +144,8 @@ private:
     int proposeBreaks(const std::vector<std::uint8_t>& over, std::uint8_t* proposed) const;
     double strainEnergyOf(const StepState& s, int begin, int end) const;
     double blockStrainEnergy(const StepState& s, int begin, int end) const;
+    /// Whether every bond's two ends hold the same history, bit for bit.
+    bool historyOncePerBond() const;
     /// The force loop for the scene's law.
     template <bool kUpdateBonds>
     void bondForces(const StepState& s, Workspace& work, std::vector<Eigen::Vector3d>& force,
@@ -201,6 +200,7 @@ private:
     /// pairHeld_ instead: plastic_ follows it when read (syncHistory()), and it follows
     /// plastic_ when that was written (heldBehind_).
     mutable std::vector<PlasticState> plastic_;
+    mutable std::vector<int> historyFirstEnds_;  // saveState's bonds b < mirror(b)
     mutable std::vector<double> pairHeld_;
     mutable bool heldAhead_ = false, heldBehind_ = true;
     /// plastic_ from pairHeld_ where the pass moved it on.

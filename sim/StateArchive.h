@@ -57,6 +57,19 @@ public:
         append(&count, sizeof count);
         append(values.data(), values.size() * sizeof(T));
     }
+    /// A vector of `count` values, the k-th `value(k)`, read back as one (StateReader's
+    /// operator()(std::vector<T>&)): a selection of another array, saved without a copy of it.
+    template <class T, class Value>
+    requires detail::kRaw<T>
+    void vectorOf(std::uint64_t count, Value value) {
+        append(&count, sizeof count);
+        const std::size_t at = bytes_.size();
+        bytes_.resize(at + count * sizeof(T));
+        for (std::uint64_t k = 0; k < count; ++k) {
+            const T v = value(k);
+            std::memcpy(bytes_.data() + at + k * sizeof(T), &v, sizeof(T));
+        }
+    }
     const std::vector<std::byte>& bytes() const { return bytes_; }
     std::vector<std::byte> take() { return std::move(bytes_); }
 

@@ -338,6 +338,50 @@ TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {
     }
 }
 
+// A checkpoint holds the elastoplastic history once per bond, both its ends holding the same
+// bits, and per end when they differ; either reads back bit for bit.
+TEST(PairLoop, ACheckpointHoldsTheHistoryOncePerBondUnlessItsEndsDiffer) {
+    const MembraneParams params = SmallSheet::params(BondLawKind::Elastoplastic);
+    SmallSheet sheet(params);
+    auto& [p, lattice, bonds, volumes, solver, damage] = sheet;
+    const int n = int(lattice.positions.size());
+    std::vector<Eigen::Vector3d> x = lattice.positions, v(n, Eigen::Vector3d::Zero());
+    for (int i = 0; i < n; ++i)
+        for (int a = 0; a < 2; ++a)
+            x[i][a] += 0.006 * p.sheet.dx * (2.0 * uniformFromHash(5, 3 * i + a) - 1.0);
+    solver.advanceAt(x, v, 1e-5);
+    auto saved = [](const PeridynamicBonds& s) {
+        StateWriter out;
+        s.saveState(out);
+        return out.take();
+    };
+    auto historyAfterLoading = [&](const std::vector<std::byte>& state) {
+        SmallSheet other(params);
+        StateReader in(state);
+        other.solver.loadState(in);
+        in.finish();
+        return other.solver.plasticState();
+    };
+    auto sameBits = [](const std::vector<PlasticState>& a, const std::vector<PlasticState>& b) {
+        return a.size() == b.size() &&
+               std::memcmp(a.data(), b.data(), a.size() * sizeof(PlasticState)) == 0;
+    };
+    const std::vector<std::byte> once = saved(solver);
+    const std::vector<PlasticState> history = solver.plasticState();
+    EXPECT_GT(
+        std::count_if(history.begin(), history.end(),
+                      [&](const PlasticState& s) { return s.maxStrain > p.material.yieldStrain; }),
+        100)
+        << "the test yields bonds";
+    EXPECT_TRUE(sameBits(historyAfterLoading(once), history));
+
+    solver.plasticState()[7].maxStrain = std::nextafter(history[7].maxStrain, 1.0);  // one end
+    const std::vector<std::byte> perEnd = saved(solver);
+    EXPECT_EQ(perEnd.size(), once.size() + bonds.directedCount() / 2 * sizeof(PlasticState));
+    EXPECT_TRUE(sameBits(historyAfterLoading(perEnd), solver.plasticState()));
+    EXPECT_FALSE(sameBits(historyAfterLoading(perEnd), history));
+}
+
 /// Membrane::failureApproachRate's loop over bonds, as written there.
 double approachOverBonds(const BondFamilies& bonds, const DamageState& damage,
                          const FailureApproach& f, const std::vector<Eigen::Vector3d>& x,

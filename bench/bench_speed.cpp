@@ -17,7 +17,9 @@
 // after their steps: ns per particle-step on 1 thread. Last, crack_path_sources as shipped
 // (hexagonal, adaptive steps, frame by frame) for the linear and elastoplastic laws, with the
 // adaptive step's failure approach rate measured in the next step's force pass and in a pass of
-// its own (Membrane::setApproachInPass(false)): what that saves.
+// its own (Membrane::setApproachInPass(false)): what that saves. Then seconds a frame of
+// foil_tear_heat at final quality with a cache file a frame, written by the run itself and by a
+// thread of its own while the next frame simulates (app/CacheWriter.h).
 //
 // Every rend figure is the fastest of five spans of its steps, and the one-thread rows and
 // LAMMPS run pinned to one core, the fastest of the usable ones by a dependent add loop at the
@@ -48,6 +50,9 @@
 #include <string>
 #include <vector>
 
+#include "app/Cache.h"
+#include "app/CacheWriter.h"
+#include "app/Pipeline.h"
 #include "app/Scene.h"
 #include "app/Threads.h"
 #include "sim/Diffusion.h"
@@ -319,6 +324,57 @@ std::array<double, 2> adaptiveRow(const char* law) {
     return fastest;
 }
 
+/// Seconds per frame of foil_tear_heat at final quality (251,444 particles, elastoplastic,
+/// adaptive steps) simulated on one thread with a cache file a frame (--cache-every 1): written
+/// by the run itself after each frame (writeCacheFrame, the order until 2026-11-29), and by a
+/// thread of its own while the next frame simulates (CacheWriter, waited for after it, as
+/// rend run does). Two membranes through the same frames, in alternate spans of 4 frames after
+/// 2, the fastest span of three each. Not pinned: the writer takes another core.
+std::array<double, 2> cacheRow() {
+    const rend::Scene s = rend::loadScene(
+        std::string(REND_SOURCE_DIR) + "/scenes/foil_tear_heat.toml", {"sheet.quality=final"});
+    rend::sim::Membrane inRun = rend::prepareMembrane(s), ownThread = rend::prepareMembrane(s);
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("rend_bench_cache_" + std::to_string(getpid()));
+    omp_set_num_threads(1);
+    rend::CacheWriter writer(dir / "own");
+    const double frame = 1.0 / s.sim.time.fps;
+    const auto cached = [&](rend::sim::Membrane& m, int f, std::vector<std::byte> reuse) {
+        return rend::CacheFrame{f, m.time(), s.simulationFingerprint,
+                                std::uint64_t(m.particleCount()), m.saveState(std::move(reuse))};
+    };
+    std::vector<std::byte> kept;
+    const auto writtenInRun = [&](int first, int count) {
+        for (int f = first; f < first + count; ++f) {
+            inRun.advanceTo(f * frame);
+            rend::CacheFrame c = cached(inRun, f, std::move(kept));
+            rend::writeCacheFrame(dir / "run", c);
+            kept = std::move(c.state);
+        }
+    };
+    const auto writtenOnItsThread = [&](int first, int count) {
+        for (int f = first; f < first + count; ++f) {
+            ownThread.advanceTo(f * frame);
+            writer.wait();
+            writer.start(cached(ownThread, f, writer.takeStorage()));
+        }
+        writer.wait();  // the span ends with its frames written
+    };
+    writtenInRun(1, 2), writtenOnItsThread(1, 2);
+    std::array<double, 2> fastest{std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::infinity()};
+    for (int span = 0, first = 3; span < 3; ++span, first += 4) {
+        Clock::time_point start = Clock::now();
+        writtenInRun(first, 4);
+        fastest[0] = std::min(fastest[0], secondsSince(start) / 4.0);
+        start = Clock::now();
+        writtenOnItsThread(first, 4);
+        fastest[1] = std::min(fastest[1], secondsSince(start) / 4.0);
+    }
+    std::filesystem::remove_all(dir);
+    return fastest;
+}
+
 /// A figure of rend's with LAMMPS's runs just before and after it on the same core (gOneCore),
 /// the faster of the two: this VM's cores slow down for minutes at a time, so a ratio means
 /// something only between runs seconds apart. lammps is negative without them.
@@ -484,6 +540,13 @@ int main(int argc, char** argv) {
         std::printf("%-32s %18.1f %18.1f %9.0f%%\n", law, ns[0], ns[1],
                     100.0 * (1.0 - ns[0] / ns[1]));
     }
+    const std::array<double, 2> frameSeconds = cacheRow();
+    std::printf(
+        "\nseconds a frame, foil_tear_heat at final quality (251,444 particles, elastoplastic, "
+        "adaptive), 1 thread, a cache file a frame\n%-32s %18s %18s %10s\n%-32s %18.3f %18.3f "
+        "%9.0f%%\n",
+        "", "written in the run", "on its own thread", "saved", "frame and cache", frameSeconds[0],
+        frameSeconds[1], 100.0 * (1.0 - frameSeconds[1] / frameSeconds[0]));
     if (!lmp) return 0;
     std::printf(
         "\nthe same as times faster than LAMMPS peri/pmb (10,201 particles) run on the same core "

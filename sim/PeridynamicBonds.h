@@ -74,7 +74,7 @@ public:
         slab_ = slab;
         return true;
     }
-    /// The strain energy of the bonds of the particles of its slab (half of each bond's).
+    /// The strain energy of the bonds whose smaller end is a particle of its slab.
     double slabStrainEnergy(const StepState& s) const {
         syncHistory();
         return strainEnergyOf(s, slab_.begin, slab_.end);

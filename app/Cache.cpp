@@ -163,8 +163,12 @@ CacheFrame readCacheFrame(const std::filesystem::path& file) {
     get(raw, at, stored);
     if (stored != expected) fail(file, "damaged: its header's checksum does not match");
     if (h.version != kFormatVersion)
-        fail(file, "written by cache format " + std::to_string(h.version) + ", this rend reads " +
-                       std::to_string(kFormatVersion));
+        throw CacheError(file.string() + ": error: written by cache format " +
+                         std::to_string(h.version) + ", this rend reads " +
+                         std::to_string(kFormatVersion) +
+                         ": another version of rend wrote it. Rerun rend run into this folder "
+                         "without --resume (it writes the cache again), or finish the shot with "
+                         "the rend that wrote it.");
     if (bytes.size() - kHeaderBytes != h.compressedBytes)
         fail(file, "truncated or extended: " + std::to_string(bytes.size() - kHeaderBytes) +
                        " bytes of state, the header says " + std::to_string(h.compressedBytes));
@@ -195,13 +199,15 @@ CacheFrame readCacheFrameFor(const std::filesystem::path& outDir, int frame,
 }
 
 std::optional<int> lastCompleteCacheFrame(const std::filesystem::path& outDir, int upTo,
-                                          std::uint64_t fingerprint, std::uint64_t particles) {
+                                          std::uint64_t fingerprint, std::uint64_t particles,
+                                          std::string* newestRefused) {
     for (int frame = upTo; frame >= 1; --frame) {
         if (!std::filesystem::exists(outDir / cacheFileName(frame))) continue;
         try {
             readCacheFrameFor(outDir, frame, fingerprint, particles);
             return frame;
-        } catch (const CacheError&) {
+        } catch (const CacheError& e) {
+            if (newestRefused && newestRefused->empty()) *newestRefused = e.what();
         }
     }
     return std::nullopt;

@@ -68,8 +68,10 @@ CacheFrame readCacheFrameFor(const std::filesystem::path& outDir, int frame,
                              std::uint64_t fingerprint, std::uint64_t particles);
 
 /// The highest frame <= `upTo` whose cache file reads back whole for this scene; nullopt when
-/// none does. Damaged or foreign files are skipped (a killed run's last file may be either).
+/// none does. Damaged or foreign files are skipped (a killed run's last file may be either);
+/// the newest one's fault goes to `newestRefused` when given (a cache of another format, say).
 std::optional<int> lastCompleteCacheFrame(const std::filesystem::path& outDir, int upTo,
-                                          std::uint64_t fingerprint, std::uint64_t particles);
+                                          std::uint64_t fingerprint, std::uint64_t particles,
+                                          std::string* newestRefused = nullptr);
 
 }  // namespace rend

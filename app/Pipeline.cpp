@@ -360,13 +360,15 @@ namespace {
 int resumeFromCache(const Scene& scene, const std::filesystem::path& outDir, int last,
                     sim::Membrane& membrane) {
     const std::uint64_t particles = std::uint64_t(membrane.particleCount());
-    const std::optional<int> frame =
-        lastCompleteCacheFrame(outDir, last, scene.simulationFingerprint, particles);
+    std::string newestRefused;
+    const std::optional<int> frame = lastCompleteCacheFrame(
+        outDir, last, scene.simulationFingerprint, particles, &newestRefused);
     if (!frame)
         throw SceneError("--resume: error: " + outDir.string() +
                          " holds no complete cached frame of this scene (cache/frame_N.rcache "
                          "written by rend run with the same scene and --set values). Run "
-                         "without --resume.");
+                         "without --resume." +
+                         (newestRefused.empty() ? "" : " The newest cache file: " + newestRefused));
     const CacheFrame cached =
         readCacheFrameFor(outDir, *frame, scene.simulationFingerprint, particles);
     try {

@@ -351,6 +351,21 @@ check "--cache-every 0 writes no cache" run 0 run scenes/stretch.toml --set time
 check "--cache-every 0 leaves no cache folder" test ! -e "$tmp/nocache/cache"
 check "--cache-every 4 caches every fourth frame" run 0 run scenes/stretch.toml --set time.duration=0.5 --renderer none --cache-every 4 --out "$tmp/every4"
 check "every fourth frame cached" test "$(ls "$tmp/every4/cache" | tr '\n' ' ')" = "frame_0004.rcache frame_0008.rcache frame_0012.rcache source.toml "
+# A cache of another format (its header rewritten to format 2, with the header's checksum) is
+# refused by --resume with the reason, not only "no complete cached frame".
+python3 - "$tmp/every4/cache" <<'PY'
+import pathlib, struct, sys
+for f in pathlib.Path(sys.argv[1]).glob("*.rcache"):
+    data = bytearray(f.read_bytes())
+    data[8:12] = struct.pack("<I", 2)
+    h = 0xcbf29ce484222325
+    for b in data[:56]:
+        h = ((h ^ b) * 0x100000001b3) & 0xFFFFFFFFFFFFFFFF
+    data[56:64] = struct.pack("<Q", h)
+    f.write_bytes(bytes(data))
+PY
+check "resume from another format's cache refused" run 2 run scenes/stretch.toml --set time.duration=0.5 --renderer none --cache-every 4 --out "$tmp/every4" --resume
+check "resume from another format's cache says why" grep -q "frame_0012.rcache: error: written by cache format 2, this rend reads 3: another version of rend wrote it" "$tmp/stderr"
 check "check prints the cache estimate" run 0 check scenes/towel_pile.toml
 check "cache estimate line" grep -qE "cache \(rend run --cache-every 1\): [0-9.]+ MB a frame" "$tmp/stdout"
 

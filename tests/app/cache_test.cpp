@@ -182,4 +182,11 @@ TEST(Cache, TheLastCompleteFrameSkipsAKilledRunsDamagedTail) {
     EXPECT_EQ(lastCompleteCacheFrame(dir, 10, 0x1234abcdULL, 1000), 3);
     EXPECT_EQ(lastCompleteCacheFrame(dir, 2, 0x1234abcdULL, 1000), 2) << "within the run's frames";
     EXPECT_EQ(lastCompleteCacheFrame(dir, 10, 0x999ULL, 1000), std::nullopt) << "another scene's";
+    std::string refused;
+    EXPECT_EQ(lastCompleteCacheFrame(dir, 10, 0x1234abcdULL, 1000, &refused), 3);
+    EXPECT_NE(refused.find(fourth.string() + ": error: "), std::string::npos) << refused;
+    refused.clear();
+    lastCompleteCacheFrame(dir, 10, 0x999ULL, 1000, &refused);
+    EXPECT_NE(refused.find(fourth.string() + ": error: "), std::string::npos)
+        << "the newest file's fault: " << refused;
 }

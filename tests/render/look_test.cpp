@@ -339,6 +339,39 @@ TEST(ToneMap, EighteenPercentGreyStaysMidGrey) {
     EXPECT_LT(byte, 170);
 }
 
+// displayByte searches thresholds rather than calling pow: the bytes of the formula, for values
+// on, next to and between every threshold, and across the range, both curves and exposures.
+TEST(ToneMap, TheDisplayByteIsTheGammaFormulasOwn) {
+    const auto formula = [](double linear, const render::ToneMapping& tone) {
+        const double c = std::pow(render::toneMap(linear, tone), 1.0 / 2.2);
+        return int(std::lround(std::clamp(c, 0.0, 1.0) * 255.0));
+    };
+    const render::ToneMapping clamp{render::ToneCurve::Clamp, 0.0};
+    std::vector<double> values{
+        0.0, -1.0, 1.0, 2.0, 1e-300, std::nan(""), std::numeric_limits<double>::infinity()};
+    for (int k = 1; k < 256; ++k) {
+        double at = std::pow((k - 0.5) / 255.0, 2.2);
+        for (int step = 0; step < 8; ++step) at = std::nextafter(at, 0.0);
+        for (int step = 0; step < 17; ++step, at = std::nextafter(at, 2.0)) values.push_back(at);
+        values.push_back(std::pow((k - 0.25) / 255.0, 2.2));
+    }
+    int checked = 0, differ = 0;
+    for (const double v : values)
+        differ += render::displayByte(v, clamp) != formula(v, clamp), ++checked;
+    for (const double exposure : {-2.0, 0.0, 1.5})
+        for (const render::ToneCurve curve :
+             {render::ToneCurve::Filmic, render::ToneCurve::Clamp}) {
+            const render::ToneMapping tone{curve, exposure};
+            for (int i = 0; i <= 200000; ++i) {
+                const double v = 4.0 * i / 200000.0;
+                differ += render::displayByte(v, tone) != formula(v, tone), ++checked;
+            }
+        }
+    EXPECT_EQ(differ, 0) << "of " << checked;
+    EXPECT_EQ(render::displayByte(std::pow(254.5 / 255.0, 2.2), clamp),
+              formula(std::pow(254.5 / 255.0, 2.2), clamp));
+}
+
 TEST(ToneMap, ExposureIsInStopsAndBadRadianceIsBlack) {
     const render::ToneMapping plusOne{render::ToneCurve::Filmic, 1.0};
     EXPECT_DOUBLE_EQ(render::toneMap(0.25, plusOne), render::filmicCurve(0.5));

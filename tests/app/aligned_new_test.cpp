@@ -3,6 +3,7 @@
 // and from 4 MiB on a 2 MiB huge page.
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <cstdint>
 #include <cstdlib>
@@ -96,6 +97,31 @@ TEST(AlignedNew, ALargeBlockInReusedMemoryGetsHugePages) {
     EXPECT_EQ(block[block.size() / 2], 2);
     EXPECT_GE(hugeKilobytesAt(block.data() + (std::size_t(4) << 20)), 2048);
     std::free(keep);
+}
+
+// A large block freed and taken again keeps its pages: they were given back once, when first
+// taken, and not again (the frame's meshes and buffers, every frame). Given back, they would read
+// as zeros.
+TEST(AlignedNew, ALargeBlockTakenAgainKeepsItsPages) {
+    constexpr std::size_t kBlock = std::size_t(12) << 20;
+    // Kept in the heap, as malloc's dynamic thresholds keep a run's frame blocks once it has
+    // freed one (a block mapped on its own is unmapped when freed, a trimmed top given back:
+    // memory taken again there is zeros whatever this file does).
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 64 << 20);
+    auto* first = static_cast<unsigned char*>(::operator new(kBlock));
+    for (std::size_t k = 0; k < kBlock; k += 4096) first[k] = 7;
+    void* const firstAddress = first;
+    ::operator delete(first);
+    auto* again = static_cast<unsigned char*>(::operator new(kBlock));
+    if (static_cast<void*>(again) != firstAddress) {
+        ::operator delete(again);
+        GTEST_SKIP() << "malloc placed the second block elsewhere";
+    }
+    int kept = 0;
+    for (std::size_t k = std::size_t(4) << 20; k < kBlock; k += 4096) kept += again[k] == 7;
+    EXPECT_EQ(kept, int((kBlock - (std::size_t(4) << 20)) / 4096));
+    ::operator delete(again);
 }
 
 TEST(AlignedNew, AMembranesParticleArraysStartOnACacheLine) {

@@ -1203,7 +1203,7 @@ Image EmbreeRenderer::Impl::trace(const Tracer& tracer, const CameraRays& camera
     if (denoised && spp == 1) guides.variance.clear();  // no spread from one sample
     if (denoised) denoiser(linear, guides);
     Image image{camera.width, camera.height, std::vector<std::uint8_t>(pixels * 3)};
-    for (std::size_t i = 0; i < pixels * 3; ++i) image.rgb[i] = displayByte(linear[i], tracer.tone);
+    displayBytes(linear, image.rgb, tracer.tone);
     if (layers) layers->rgb = linear;
     return image;
 }

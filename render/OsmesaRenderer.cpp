@@ -291,12 +291,14 @@ Image OsmesaRenderer::Impl::resolve(int outWidth, int outHeight, int ss,
                                     const ToneMapping& tone) const {
     Image image{outWidth, outHeight,
                 std::vector<std::uint8_t>(std::size_t(outWidth) * outHeight * 3)};
+    std::vector<double> row(std::size_t(outWidth) * 3);  // a row's linear channels
     for (int y = 0; y < outHeight; ++y) {
         for (int x = 0; x < outWidth; ++x) {
             const Eigen::Vector3d c = blockMean(x, y, ss);
-            std::uint8_t* out = &image.rgb[(std::size_t(y) * outWidth + x) * 3];
-            for (int k = 0; k < 3; ++k) out[k] = displayByte(kHeadroom * c[k], tone);
+            for (int k = 0; k < 3; ++k) row[std::size_t(x) * 3 + k] = kHeadroom * c[k];
         }
+        displayBytes(row, std::span(image.rgb).subspan(std::size_t(y) * outWidth * 3, row.size()),
+                     tone);
     }
     return image;
 }

@@ -3,6 +3,7 @@
 // the 2.2 display gamma, so the two renderers' frames stay comparable.
 
 #include <cstdint>
+#include <span>
 
 #include "render/RenderSettings.h"
 
@@ -22,5 +23,12 @@ double toneMap(double linear, const ToneMapping& tone);
 
 /// toneMap, then the 2.2 display gamma, rounded to a byte.
 std::uint8_t displayByte(double linear, const ToneMapping& tone);
+
+/// displayByte of every value of `linear` into `bytes` (as many): the same bytes, a frame's
+/// pixels at a time.
+void displayBytes(std::span<const double> linear, std::span<std::uint8_t> bytes,
+                  const ToneMapping& tone);
+void displayBytes(std::span<const float> linear, std::span<std::uint8_t> bytes,
+                  const ToneMapping& tone);
 
 }  // namespace rend::render

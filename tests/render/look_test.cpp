@@ -372,6 +372,34 @@ TEST(ToneMap, TheDisplayByteIsTheGammaFormulasOwn) {
               formula(std::pow(254.5 / 255.0, 2.2), clamp));
 }
 
+// A frame's channels at once (both renderers' images): each value's own displayByte, over the
+// thresholds, the range, the bad values and a block's end, in double and in float.
+TEST(ToneMap, AFramesBytesAreEachValuesOwn) {
+    std::vector<double> values{0.0,    -1.0,         2.0,
+                               1e-300, std::nan(""), std::numeric_limits<double>::infinity()};
+    for (int k = 1; k < 256; ++k) {
+        double at = std::pow((k - 0.5) / 255.0, 2.2);
+        for (int step = 0; step < 3; ++step) at = std::nextafter(at, 0.0);
+        for (int step = 0; step < 7; ++step, at = std::nextafter(at, 2.0)) values.push_back(at);
+    }
+    for (int i = 0; i < 3001; ++i) values.push_back(4.0 * i / 3000.0);  // not whole blocks
+    const std::vector<float> floats(values.begin(), values.end());
+    for (const double exposure : {-2.0, 0.0, 1.5})
+        for (const render::ToneCurve curve :
+             {render::ToneCurve::Filmic, render::ToneCurve::Clamp}) {
+            const render::ToneMapping tone{curve, exposure};
+            std::vector<std::uint8_t> bytes(values.size(), 7), fromFloats(values.size(), 7);
+            render::displayBytes(values, bytes, tone);
+            render::displayBytes(floats, fromFloats, tone);
+            int differ = 0;
+            for (std::size_t i = 0; i < values.size(); ++i) {
+                differ += bytes[i] != render::displayByte(values[i], tone);
+                differ += fromFloats[i] != render::displayByte(double(floats[i]), tone);
+            }
+            EXPECT_EQ(differ, 0) << "of " << 2 * values.size() << ", exposure " << exposure;
+        }
+}
+
 TEST(ToneMap, ExposureIsInStopsAndBadRadianceIsBlack) {
     const render::ToneMapping plusOne{render::ToneCurve::Filmic, 1.0};
     EXPECT_DOUBLE_EQ(render::toneMap(0.25, plusOne), render::filmicCurve(0.5));

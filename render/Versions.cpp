@@ -3,6 +3,7 @@
 #include <assimp/version.h>
 #include <embree3/rtcore.h>
 #include <openvdb/openvdb.h>
+#include <zlib.h>
 
 #include <stdexcept>
 
@@ -57,6 +58,7 @@ std::vector<std::pair<std::string, std::string>> renderLibraryVersions() {
         {"assimp", assimpVersion()},
         {"OSMesa", osmesaVersion()},
         {"stb", "stb_image_write (libstb-dev)"},
+        {"zlib", zlibVersion()},
     };
 }
 

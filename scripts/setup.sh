@@ -6,7 +6,8 @@ set -euo pipefail
 packages=(
     cmake g++ ninja-build pkg-config clang-format python3
     libeigen3-dev libembree-dev libopenvdb-dev libboost-dev libboost-iostreams-dev libtbb-dev
-    zlib1g-dev libopenexr-dev  # OpenEXR 3.1: frames for compositing (render/ExrWriter)
+    zlib1g-dev  # the PNG frames' deflate (render/Image)
+    libopenexr-dev  # OpenEXR 3.1: frames for compositing (render/ExrWriter)
     libosmesa6-dev libstb-dev libassimp-dev libtomlplusplus-dev libcli11-dev
     libzstd-dev  # the simulation cache (app/Cache): compressed, checksummed frames
     libopenmpi-dev openmpi-bin  # mpirun -np N rend run (app/MpiDomain), tests/mpi_test.sh

@@ -3,7 +3,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdint>
-#include <unordered_map>
+#include <utility>
+
+#include "sim/TriangleEdges.h"
 
 namespace rend::render {
 
@@ -13,45 +15,29 @@ namespace {
 // outside the sheet: the hexagonal zig-zag's notches are 120 degrees, a rectangle's corners 90.
 const double kNotchCosine = -0.3;  // cos(107.5 degrees)
 
-std::uint64_t edgeKey(int a, int b) {
-    const auto [lo, hi] = std::minmax(a, b);
-    return (std::uint64_t(std::uint32_t(lo)) << 32) | std::uint32_t(hi);
-}
-
 }  // namespace
 
 void incidentTriangles(const std::vector<std::array<int, 3>>& triangles, std::size_t vertexCount,
                        std::vector<int>& offsets, std::vector<int>& incident) {
-    offsets.assign(vertexCount + 1, 0);
-    for (const auto& t : triangles)
-        for (int v : t) ++offsets[v + 1];
-    for (std::size_t i = 1; i < offsets.size(); ++i) offsets[i] += offsets[i - 1];
-    incident.resize(offsets.back());
-    std::vector<int> fill(offsets.begin(), offsets.end() - 1);
-    for (int t = 0; t < int(triangles.size()); ++t)
-        for (int v : triangles[t]) incident[fill[v]++] = t;
+    sim::trianglesAtCorners(triangles, vertexCount, offsets, incident);
 }
 
 RestEdges restEdges(const std::vector<std::array<int, 3>>& triangles) {
+    sim::TriangleEdges numbered = sim::triangleEdges(triangles, 0);  // side k from corner k
     RestEdges edges;
-    edges.ofTriangle.resize(triangles.size());
+    edges.ends = std::move(numbered.ends);
+    edges.ofTriangle = std::move(numbered.ofTriangle);
     edges.neighbours.assign(triangles.size(), {-1, -1, -1});
-    std::unordered_map<std::uint64_t, int> index;  // set-up only
-    index.reserve(triangles.size() * 2);
-    for (int t = 0; t < int(triangles.size()); ++t) {
-        for (int k = 0; k < 3; ++k) {
-            const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-            const auto [it, added] = index.try_emplace(edgeKey(a, b), int(edges.ends.size()));
-            const int e = it->second;
-            edges.ofTriangle[t][k] = e;
-            if (added) {
-                edges.ends.push_back({std::min(a, b), std::max(a, b)});
-                edges.triangles.push_back({t, -1});
-            } else if (edges.triangles[e][1] < 0) {
-                edges.triangles[e][1] = t;
-            }
+    // The first two triangles on each edge.
+    edges.triangles.assign(edges.ends.size(), {-1, -1});
+    for (int t = 0; t < int(triangles.size()); ++t)
+        for (const int e : edges.ofTriangle[t]) {
+            auto& on = edges.triangles[e];
+            if (on[0] < 0)
+                on[0] = t;
+            else if (on[1] < 0)
+                on[1] = t;
         }
-    }
     for (int t = 0; t < int(triangles.size()); ++t)
         for (int k = 0; k < 3; ++k) {
             const int e = edges.ofTriangle[t][k];

@@ -1,7 +1,9 @@
 #include "sim/DamageState.h"
 
 #include <algorithm>
-#include <map>
+#include <utility>
+
+#include "sim/TriangleEdges.h"
 
 namespace rend::sim {
 
@@ -23,23 +25,21 @@ DamageState::DamageState(const BondFamilies& bonds, std::span<const std::array<i
     for (int i = 0; i < bonds.particleCount(); ++i)
         for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; ++b)
             mirror_[b] = bondOf(bonds.partners[b], i);
-    std::map<std::array<int, 2>, int> index;  // set-up only
-    triangleEdges_.resize(triangles.size());
+    TriangleEdges numbered = sim::triangleEdges(triangles, 1);  // side s opposite corner s
+    edges_ = std::move(numbered.ends);
+    triangleEdges_ = std::move(numbered.ofTriangle);
+    edgeBonds_.resize(edges_.size());
+    for (std::size_t e = 0; e < edges_.size(); ++e) {
+        edgeBonds_[e] = {bondOf(edges_[e][0], edges_[e][1]), bondOf(edges_[e][1], edges_[e][0])};
+        for (const int bond : edgeBonds_[e])
+            if (bond >= 0) bondEdge_[bond] = int(e);
+    }
+    // The first triangle on each edge, and the last after it.
+    edgeTriangles_.assign(edges_.size(), {-1, -1});
     for (int t = 0; t < int(triangles.size()); ++t)
-        for (int s = 0; s < 3; ++s) {
-            const int a = triangles[t][(s + 1) % 3], b = triangles[t][(s + 2) % 3];
-            const std::array<int, 2> key{std::min(a, b), std::max(a, b)};
-            const auto [it, added] = index.try_emplace(key, int(edges_.size()));
-            if (added) {
-                edges_.push_back(key);
-                edgeBonds_.push_back({bondOf(key[0], key[1]), bondOf(key[1], key[0])});
-                edgeTriangles_.push_back({t, -1});
-                for (int bond : edgeBonds_.back())
-                    if (bond >= 0) bondEdge_[bond] = it->second;
-            } else {
-                edgeTriangles_[it->second][1] = t;
-            }
-            triangleEdges_[t][s] = it->second;
+        for (const int e : triangleEdges_[t]) {
+            auto& on = edgeTriangles_[e];
+            (on[0] < 0 ? on[0] : on[1]) = t;
         }
     edgeAlive_.assign(edges_.size(), 1);
 }

@@ -18,8 +18,8 @@ struct TriangleEdges {
 };
 
 /// Found through the triangles around each corner (a few each on a lattice), not a map of every
-/// pair: a final-quality sheet's 750,000 edges in a few hundredths of a second rather than the
-/// 0.2-0.3 s each of the two maps took. Corners must be non-negative.
+/// pair: 576,423 triangles (a 289,289-particle sheet) in 0.04-0.06 s, where inserting their
+/// sides into a std::map alone took 0.13-0.19 s. Corners must be non-negative.
 TriangleEdges triangleEdges(std::span<const std::array<int, 3>> triangles, int firstCorner);
 
 /// The triangles at each corner v < cornerCount, ascending: at[offsets[v] .. offsets[v + 1]).

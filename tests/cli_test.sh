@@ -221,8 +221,9 @@ full_disk() {  # full_disk KIB args... : rend run, writes past KIB KiB fail (EFB
     )
     [[ $? -eq 1 ]]
 }
-check "full disk at a PNG exits 1" full_disk 40 scenes/stretch.toml "${small[@]}" --out "$tmp/full" \
-    --set render.width=1920 --set render.height=1080
+# The frame's PNG (15 KB: zlib's deflate) is the first file past 8 KiB; run.json is 3.5 KB.
+check "full disk at a PNG exits 1" full_disk 8 scenes/stretch.toml "${small[@]}" --out "$tmp/full" \
+    --set render.width=2560 --set render.height=1440
 check "full disk names the PNG and the reason" grep -q "cannot write $tmp/full/frames/frame_0001.png: File too large" "$tmp/stderr"
 check "full disk leaves no truncated PNG" pngs_complete "$tmp/full"
 check "full disk leaves no empty file" no_empty_files "$tmp/full"

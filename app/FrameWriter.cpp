@@ -55,6 +55,9 @@ struct FrameWriter::Parts {
     double exportVoxel = 0.0;  ///< the exported volume's, resolved on its first frame
     std::unique_ptr<render::OsmesaRenderer> osmesa;
     std::unique_ptr<render::EmbreeRenderer> embree;
+    /// The last frame's surface: a mesh is built into it again, its arrays' storage kept (the
+    /// final foil's 50 MB, zeroed by the kernel in fresh pages each frame before).
+    render::Geometry geometry;
 };
 
 FrameWriter::FrameWriter(const Scene& scene, const std::filesystem::path& outDir)
@@ -84,20 +87,23 @@ std::vector<std::string> FrameWriter::plannedFiles(int frame) const {
     return names;
 }
 
-render::Geometry FrameWriter::buildSurface(const sim::FrameView& view) {
+const render::Geometry& FrameWriter::buildSurface(const sim::FrameView& view) {
     Parts& p = *parts_;
     switch (scene_.render.surface) {
         case render::SurfaceKind::Splat:
             if (!p.splat) p.splat = std::make_unique<render::SplatSurface>(view);
-            return p.splat->build(view, scene_.render);
+            return p.geometry = p.splat->build(view, scene_.render);
         case render::SurfaceKind::Vdb:
             if (!p.vdb) p.vdb = std::make_unique<render::VdbSurface>(view, scene_.render.vdb);
-            return p.vdb->build(view, scene_.render);
+            return p.geometry = p.vdb->build(view, scene_.render);
         case render::SurfaceKind::ParticleLevelSet:
         case render::SurfaceKind::Lattice:
             break;
     }
-    return meshSurface(view).build(view, scene_.render);
+    render::LatticeSurface& surface = meshSurface(view);
+    if (!std::holds_alternative<render::Mesh>(p.geometry)) p.geometry = render::Mesh{};
+    surface.build(view, scene_.render, std::get<render::Mesh>(p.geometry));
+    return p.geometry;
 }
 
 render::LatticeSurface& FrameWriter::meshSurface(const sim::FrameView& view) {
@@ -170,7 +176,7 @@ void FrameWriter::write(const sim::FrameView& view, StageTimes& seconds,
                         std::vector<std::string>& written) {
     if (!active()) return;
     auto t0 = Clock::now();
-    const render::Geometry geometry = buildSurface(view);
+    const render::Geometry& geometry = buildSurface(view);
     seconds.surface += secondsSince(t0);
     if (scene_.renderer != RendererKind::None) {
         t0 = Clock::now();

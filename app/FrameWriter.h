@@ -42,7 +42,8 @@ public:
     render::SheetVolumeInfo lastVolume() const { return lastVolume_; }
 
 private:
-    render::Geometry buildSurface(const sim::FrameView& view);
+    /// The frame's surface, built into the last frame's (Parts::geometry) where it is a mesh.
+    const render::Geometry& buildSurface(const sim::FrameView& view);
     /// The lattice surface, or with surface = "particle_level_set" its level-set outline; the
     /// exports' mid-surface is the same one.
     render::LatticeSurface& meshSurface(const sim::FrameView& view);

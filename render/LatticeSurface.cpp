@@ -28,9 +28,10 @@ constexpr int kSmoothingPasses = 4;
 // ones (or one) 0.
 constexpr double kSpanRatio = 0.05;
 
-std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& positions,
-                                           const std::vector<std::array<std::uint32_t, 3>>& tris) {
-    std::vector<Eigen::Vector3f> normals(positions.size(), Eigen::Vector3f::Zero());
+void smoothNormals(const std::vector<Eigen::Vector3f>& positions,
+                   const std::vector<std::array<std::uint32_t, 3>>& tris,
+                   std::vector<Eigen::Vector3f>& normals) {
+    normals.assign(positions.size(), Eigen::Vector3f::Zero());
     for (const auto& t : tris) {
         // The unnormalised cross product is twice the area, which gives area weighting.
         const Eigen::Vector3f n =
@@ -41,7 +42,6 @@ std::vector<Eigen::Vector3f> smoothNormals(const std::vector<Eigen::Vector3f>& p
         const float len = n.norm();
         n = len > 0.0f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitZ();
     }
-    return normals;
 }
 
 int vertexCount(const sim::FrameView& rest, const std::vector<std::array<int, 3>>& tris) {
@@ -725,18 +725,24 @@ private:
 };
 
 Mesh LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& settings) const {
+    Mesh mesh;
+    build(frame, settings, mesh);
+    return mesh;
+}
+
+void LatticeSurface::build(const sim::FrameView& frame, const RenderSettings& settings,
+                           Mesh& mesh) const {
     const Placed placed(*this, frame);
     Cuts cuts = findCuts(frame);
     placeCrossings(placed, cuts);
     const Corners corners = splitFans(cuts.present, frame.particleCount());
-    Mesh mesh;
+    mesh.clear();
     Builder builder(*this, frame, placed, cuts, corners, settings, mesh);
     for (int t = 0; t < static_cast<int>(triangles_.size()); ++t)
         if (cuts.present[t]) builder.addPieces(t);
     if (outline_ == Outline::LevelSet && !frame.bandTriangles.empty()) builder.addBand(frame);
-    mesh.normals = smoothNormals(mesh.positions, mesh.triangles);
+    smoothNormals(mesh.positions, mesh.triangles, mesh.normals);
     if (settings.thickness > 0.0) extrude(mesh, settings.thickness);
-    return mesh;
 }
 
 }  // namespace rend::render

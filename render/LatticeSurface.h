@@ -80,6 +80,9 @@ public:
     /// lips of every crack show as walls. Welding coincident vertices makes it closed.
     /// Large thicknesses on sharply folded sheets self-intersect: it is an offset, not a CSG.
     Mesh build(const sim::FrameView& frame, const RenderSettings& settings) const;
+    /// The same mesh into `mesh`, whose arrays keep their storage: a shot's frames build into
+    /// the last frame's mesh rather than fresh pages each time.
+    void build(const sim::FrameView& frame, const RenderSettings& settings, Mesh& mesh) const;
 
     /// Indices into FrameView::restTriangles of the triangles kept in this frame
     /// (FrameView::keptTriangles: none of their sides broken, not removed).

@@ -30,6 +30,12 @@ struct Mesh {
     };
     std::vector<Point> points;
     std::vector<std::array<std::uint32_t, 3>> triangles;
+
+    /// Empties every array, keeping its storage.
+    void clear() {
+        positions.clear(), normals.clear(), colors.clear(), layers.clear(), theta.clear();
+        points.clear(), triangles.clear();
+    }
 };
 
 /// Throws std::invalid_argument, naming `who`, when the attribute arrays differ in length or a

@@ -125,6 +125,35 @@ TEST(LatticeSurface, BuiltMeshSlitsBothTrianglesAlongABrokenBond) {
         for (auto v : t) EXPECT_LT(v, mesh.positions.size());
 }
 
+// A frame built into the last frame's mesh (app/FrameWriter keeps it) is the mesh built afresh:
+// nothing of the earlier, larger one is left, with thickness, a crack and a colour map.
+TEST(LatticeSurface, AFrameBuiltIntoTheLastFramesMeshIsTheFreshMesh) {
+    GridSheet sheet(8, 7, 1.0, [](double x, double y) { return 0.1 * x * y; });
+    const LatticeSurface surface(sheet.view());
+    RenderSettings settings;
+    settings.thickness = 0.2;
+    for (int i = 1; i < 7; ++i) sheet.breakBond(sheet.id(i, 3), sheet.id(i, 4));
+    rend::render::Mesh reused =
+        surface.build(sheet.view(), settings);  // cracked and thick: the larger
+    GridSheet later(8, 7, 1.0, [](double x, double y) { return 0.2 * x - 0.1 * y; });
+    later.breakBond(later.id(2, 2), later.id(3, 2));
+    settings.thickness = 0.0;
+    surface.build(later.view(), settings, reused);
+    const rend::render::Mesh fresh = surface.build(later.view(), settings);
+    ASSERT_LT(fresh.positions.size(), reused.positions.capacity());  // storage was kept
+    EXPECT_EQ(reused.positions, fresh.positions);
+    EXPECT_EQ(reused.normals, fresh.normals);
+    EXPECT_EQ(reused.colors, fresh.colors);
+    EXPECT_EQ(reused.layers, fresh.layers);
+    EXPECT_EQ(reused.theta, fresh.theta);
+    EXPECT_EQ(reused.triangles, fresh.triangles);
+    ASSERT_EQ(reused.points.size(), fresh.points.size());
+    for (std::size_t v = 0; v < fresh.points.size(); ++v) {
+        EXPECT_EQ(reused.points[v].id, fresh.points[v].id);
+        EXPECT_EQ(reused.points[v].rest, fresh.points[v].rest);
+    }
+}
+
 TEST(LatticeSurface, NormalsOfAFlatSheetAtRestAreUnitAndPointUp) {
     const GridSheet sheet(6, 5, 0.5);
     const auto mesh = LatticeSurface(sheet.view()).build(sheet.view(), RenderSettings{});

@@ -65,8 +65,9 @@ struct LinearPairInput {
     /// Per kPairTile pairs from a multiple of it (a vector, or two): where their ends are runs
     /// of consecutive particles, the first of each run (else -1); where their rest lengths,
     /// bond scales and limits are each one value, its class c >= 0 in the tables; where each is
-    /// its class's value plus whole steps of its unit (16 bits per pair, restSteps...),
-    /// kSteppedClass - c; else -1. Classed vectors read none of the per-pair doubles above.
+    /// its class's value plus whole steps of its unit (16 bits per pair, restSteps...; the
+    /// limits may be the class's value), steppedClass(); else -1. Classed vectors read none of
+    /// the per-pair doubles above.
     const int* runFirst = nullptr;
     const int* runSecond = nullptr;
     const int* uniform = nullptr;
@@ -78,6 +79,19 @@ struct LinearPairInput {
     int prefetchAhead = 0, particles = 0, pairs = 0;
 };
 inline constexpr int kSteppedClass = -2;
+/// A stepped row reads steps for its rest lengths and scales, and for its limits only where
+/// they are stepped too: on a lattice whose coordinates carry rounding, the rest lengths and
+/// the scales (over the rest length) are stepped and the limits one value.
+/// LinearPairInput::uniform of such a row of class c is steppedClass(c, whether its limits are
+/// stepped); steppedClassOf() gives c back, and limitsStepped() the other.
+inline constexpr int kStepsLimit = 1 << 29;
+inline constexpr int steppedClass(int c, bool limits) {
+    return kSteppedClass - c - (limits ? kStepsLimit : 0);
+}
+inline constexpr int steppedClassOf(int uniform) {
+    return (kSteppedClass - uniform) & (kStepsLimit - 1);
+}
+inline constexpr bool limitsStepped(int uniform) { return uniform <= kSteppedClass - kStepsLimit; }
 
 /// Where a pair's force lies in its slots. In rows (four or eight lanes wide, sim/PairSums.h's
 /// tile sums): rows of kPairTile slots, the x of the row's pairs, then their y, then their z, so

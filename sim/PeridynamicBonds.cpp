@@ -188,13 +188,16 @@ void PeridynamicBonds::setUpPairRows() {
             classScaleUnit_.push_back(scale->unit), classLimitUnit_.push_back(limit->unit);
         }
         const bool exact = !rest->stepped && !scale->stepped && !limit->stepped;
-        rowClass_[row] = exact ? at->second : kSteppedClass - at->second;
+        rowClass_[row] = exact ? at->second : steppedClass(at->second, limit->stepped);
     }
 }
 
 PeridynamicBonds::RowClasses PeridynamicBonds::rowClasses() const {
     RowClasses r;
-    for (const int c : rowClass_) (c >= 0 ? r.exact : c == -1 ? r.perPair : r.stepped) += 1;
+    for (const int c : rowClass_) {
+        (c >= 0 ? r.exact : c == -1 ? r.perPair : r.stepped) += 1;
+        if (c <= kSteppedClass) r.steppedLimits += limitsStepped(c);
+    }
     return r;
 }
 

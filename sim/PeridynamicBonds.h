@@ -53,9 +53,10 @@ public:
     double strainEnergy(const StepState& s, Workspace& work) const override;
     double stiffening() const override { return stiffening_; }
     /// How many rows of the vectorised pass's pairs have one rest length, scale and limit to the
-    /// bit, one plus whole steps of its last bit per pair, or neither (setUpPairRows).
+    /// bit, one plus whole steps of its last bit per pair, or neither (setUpPairRows); of the
+    /// stepped, how many have stepped limits.
     struct RowClasses {
-        int exact = 0, stepped = 0, perPair = 0;
+        int exact = 0, stepped = 0, perPair = 0, steppedLimits = 0;
     };
     RowClasses rowClasses() const;
     /// The elastoplastic history once per bond, where both ends hold the same bits (they do: a

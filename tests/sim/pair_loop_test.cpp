@@ -136,6 +136,8 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
         EXPECT_GT(rows.stepped, std::max(40, rows.exact))
             << "rows in steps: " << rows.exact << " exact, " << rows.stepped << " stepped, "
             << rows.perPair << " per pair";
+        // Rounding steps the rest lengths and scales; eta_c is one value (read without steps).
+        EXPECT_EQ(rows.steppedLimits, 0);
     }
 
     const int n = int(lattice.positions.size());
@@ -216,6 +218,77 @@ double lookAheadOverBonds(const PeridynamicBonds& solver, const BondFamilies& bo
 // On the small sheet (one block) and on one of 1 x 0.5 m (blocks of 512 particles, each
 // starting from the largest tangent of the blocks before it, on 1 and 3 threads). Particles
 // moved by `jitter` dx: much, so that one bond stands out, or little, so that many compete.
+// One row of eight pairs (lists, not runs) whose rest lengths, scales and limits are stepped
+// (LinearPairInput::uniform) in every combination, its code saying whether the limits are: the
+// forces and breaking flags are those of the same row read per pair.
+TEST(PairLoop, AStepsRowReadsItsLimitsStepsWhereItSaysSo) {
+    MaterialParams m;
+    const BondLaw law = BondLaw::fromMaterial(m, 3.0e9);
+    constexpr int kPairs = kPairTile;
+    std::vector<double> x(3 * 2 * kPairs);
+    std::vector<int> first(kPairs), second(kPairs), upper(kPairs);
+    for (int k = 0; k < kPairs; ++k) {
+        first[k] = 2 * k, second[k] = 2 * k + 1, upper[k] = k;
+        x[6 * k] = 40.3 + 0.01 * k, x[6 * k + 1] = -23.7;
+        // Stretched by 0.9-1.6 times eta_c: the flags differ between a limit and its steps.
+        x[6 * k + 3] = x[6 * k] + 0.01 * (1.0 + 0.01 * (0.9 + 0.1 * k)), x[6 * k + 4] = -23.7;
+    }
+    const double classRest = 0.01, classScale = 2.5e-9, classLimit = 0.01;
+    const double restUnit = std::ldexp(1.0, std::ilogb(classRest) - 52);
+    const double scaleUnit = std::ldexp(1.0, std::ilogb(classScale) - 52);
+    const double limitUnit = std::ldexp(1.0, std::ilogb(classLimit) - 40);  // steps of 2^-12 %
+    const std::uint8_t alive[kPairs] = {1, 1, 1, 1, 1, 1, 1, 1};
+    constexpr int kStepsRest = 1, kStepsScale = 2, kStepsLimits = 4;
+    for (int which = 1; which < 8; ++which) {
+        std::vector<std::uint16_t> restSteps(kPairs, 0), scaleSteps(kPairs, 0),
+            limitSteps(kPairs, 0);
+        std::vector<double> rest(kPairs), scale(kPairs), limit(kPairs);
+        for (int k = 0; k < kPairs; ++k) {
+            if (which & kStepsRest) restSteps[k] = std::uint16_t(300 * k);
+            if (which & kStepsScale) scaleSteps[k] = std::uint16_t(7 * k + 1);
+            if (which & kStepsLimits) limitSteps[k] = std::uint16_t(9000 * k);
+            rest[k] = classRest + restSteps[k] * restUnit;
+            scale[k] = classScale + scaleSteps[k] * scaleUnit;
+            limit[k] = classLimit + limitSteps[k] * limitUnit;
+        }
+        LinearPairInput in{first.data(), second.data(), rest.data(), scale.data(),
+                           limit.data(), x.data(),      nullptr,     law.c};
+        in.law = &law, in.alive = alive, in.allAlive = true, in.upper = upper.data();
+        in.twin = upper.data(), in.particles = 2 * kPairs, in.pairs = kPairs;
+        const int noRun = -1;
+        in.runFirst = &noRun, in.runSecond = &noRun;
+        in.classRest = &classRest, in.classScale = &classScale, in.classLimit = &classLimit;
+        in.classRestUnit = &restUnit, in.classScaleUnit = &scaleUnit;
+        in.classLimitUnit = &limitUnit;
+        in.restSteps = restSteps.data(), in.scaleSteps = scaleSteps.data();
+        in.limitSteps = limitSteps.data();
+        const auto forces = [&](int uniform, std::uint8_t& over) {
+            in.uniform = &uniform;
+            alignas(64) double slots[4 * kPairs] = {};
+            LinearPairOutput out;
+            out.force = slots, out.over = &over, out.rows = slotRows();
+            linearPairForces(in, out, 0, kPairs);
+            std::vector<double> f;
+            for (int k = 0; k < kPairs; ++k)
+                for (int a = 0; a < 3; ++a) f.push_back(out.slot(k)[a * out.slotStep()]);
+            return f;
+        };
+        std::uint8_t perPairOver = 0, steppedOver = 0;
+        const std::vector<double> perPair = forces(-1, perPairOver);
+        const std::vector<double> stepped =
+            forces(steppedClass(0, (which & kStepsLimits) != 0), steppedOver);
+        EXPECT_EQ(steppedOver, perPairOver) << "stepped constants " << which;
+        for (int k = 0; k < 3 * kPairs; ++k)
+            EXPECT_EQ(std::bit_cast<std::uint64_t>(stepped[k]),
+                      std::bit_cast<std::uint64_t>(perPair[k]))
+                << "stepped constants " << which << ", component " << k;
+        if (which == kStepsLimits) {
+            EXPECT_NE(perPairOver, 0);  // some pairs past their limits, some not
+            EXPECT_NE(perPairOver, 0xff);
+        }
+    }
+}
+
 TEST(PairLoop, ThePowerLawsLookAheadIsTheStiffestCompressedLivingBonds) {
     const int before = omp_get_max_threads();
     for (const bool large : {false, true})

@@ -73,6 +73,10 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
         seeded ? std::optional<Lattice>(seedLattice(sheet)) : std::nullopt;
     SourceFrame frame{rest, {}, seeds ? &*seeds : nullptr};
     for (const double v : volumes) frame.areas.push_back(v / sheet.thickness);
+    if (!params.diffusion.spots.empty() || !params.diffusion.scatters.empty()) {
+        frame.restByX = orderByX(rest);
+        if (seeds) frame.seedsByX = orderByX(seeds->positions);
+    }
     for (const DiffusionSpot& spot : params.diffusion.spots) addSpot(spot, frame);
     for (const SpotScatter& scatter : params.diffusion.scatters) expandScatter(scatter, frame);
     for (const DiffusionEdge& edge : params.diffusion.edges)
@@ -80,30 +84,54 @@ Diffusion::Diffusion(const MembraneParams& params, std::span<const Eigen::Vector
             if (edge.region.contains(rest[i])) held_.emplace_back(i, edge.value);
 }
 
-namespace {
-
-bool inSpot(const Eigen::Vector3d& x0, const DiffusionSpot& spot) {
-    return (x0.head<2>() - spot.center).norm() <= spot.radius;
+std::vector<int> orderByX(std::span<const Eigen::Vector3d> points) {
+    std::vector<int> order(points.size());
+    for (int i = 0; i < int(order.size()); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return points[a].x() < points[b].x(); });
+    return order;
 }
 
-}  // namespace
+std::vector<int> pointsInDisc(std::span<const Eigen::Vector3d> points, std::span<const int> byX,
+                              const Eigen::Vector2d& center, double radius) {
+    // |p - c| <= r implies |p.x - c.x| <= r with the same rounded difference (a correctly
+    // rounded root of a sum of rounded squares is at least each |component|), and that
+    // difference never falls as p.x grows: the points tested are one run of the order by x.
+    const auto within = [&](int i) { return (points[i].head<2>() - center).norm() <= radius; };
+    const auto offset = [&](int i) { return points[i].x() - center.x(); };
+    std::vector<int> inside;
+    if (byX.size() == points.size()) {
+        const auto first = std::partition_point(byX.begin(), byX.end(),
+                                                [&](int i) { return !(offset(i) >= -radius); });
+        const auto last =
+            std::partition_point(first, byX.end(), [&](int i) { return offset(i) <= radius; });
+        // A run of at most a quarter of the points, sorted back into index order; a wider
+        // disc is cheaper to find by testing every point.
+        if (4 * (last - first) <= std::ptrdiff_t(points.size())) {
+            std::vector<int> near(first, last);
+            std::sort(near.begin(), near.end());
+            for (const int i : near)
+                if (within(i)) inside.push_back(i);
+            return inside;
+        }
+    }
+    for (int i = 0; i < int(points.size()); ++i)
+        if (within(i)) inside.push_back(i);
+    return inside;
+}
 
 void Diffusion::addSpot(const DiffusionSpot& spot, const SourceFrame& frame) {
     Spot s{spot.start, spot.start + spot.duration, spot.rate, {}};
-    double area = 0.0;
-    for (int i = 0; i < int(frame.rest.size()); ++i)
-        if (inSpot(frame.rest[i], spot)) {
-            s.particles.push_back(i);
-            area += frame.areas[i];
-        }
+    s.particles = pointsInDisc(frame.rest, frame.restByX, spot.center, spot.radius);
     if (s.particles.empty()) return;
+    double area = 0.0;
+    for (const int i : s.particles) area += frame.areas[i];
     // The dose (theta x area per second) is the seed lattice's: a disc of a few particles
     // covers more or less than pi r^2, and a finer lattice must not change what it injects.
     if (frame.seeds) {
         const Lattice& seeds = *frame.seeds;
-        const auto inside =
-            std::count_if(seeds.positions.begin(), seeds.positions.end(),
-                          [&](const Eigen::Vector3d& x0) { return inSpot(x0, spot); });
+        const std::size_t inside =
+            pointsInDisc(seeds.positions, frame.seedsByX, spot.center, spot.radius).size();
         if (inside > 0) s.rate *= double(inside) * seeds.particleArea / area;
     }
     spots_.push_back(std::move(s));

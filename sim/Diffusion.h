@@ -25,6 +25,16 @@
 
 namespace rend::sim {
 
+/// The indices of `points` in increasing x (ties in increasing index): what pointsInDisc()
+/// searches.
+std::vector<int> orderByX(std::span<const Eigen::Vector3d> points);
+
+/// The points whose x y lie within `radius` of `center` (|p - c| <= radius, as a loop over every
+/// point tests it), in increasing index, through their order by x: only the points whose x lies
+/// within `radius` of the centre's are tested.
+std::vector<int> pointsInDisc(std::span<const Eigen::Vector3d> points, std::span<const int> byX,
+                              const Eigen::Vector2d& center, double radius);
+
 class Diffusion {
 public:
     Diffusion(const MembraneParams& params, std::span<const Eigen::Vector3d> rest,
@@ -65,6 +75,7 @@ private:
         std::span<const Eigen::Vector3d> rest;
         std::vector<double> areas;
         const Lattice* seeds = nullptr;
+        std::vector<int> restByX, seedsByX;  ///< orderByX() of each
     };
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <numbers>
 
+#include "sim/Diffusion.h"
 #include "sim/Fracture.h"
 #include "sim/Membrane.h"
+#include "sim/Random.h"
 #include "tests/sim/Peridynamic.h"
 
 using namespace rend::sim;
@@ -301,6 +303,45 @@ TEST(Diffusion, SpotsAddTheirRateOnlyWhileActive) {
     Membrane m(p);
     for (int s = 0; s < 100; ++s) m.step();  // t = 0.1, the spot ran from 0.01 to 0.03
     EXPECT_NEAR(m.maxTheta(), 2.0 * 0.02, 1e-9);
+}
+
+// The spots' particles, found through the order by x, are those of the loop over every point:
+// on a lattice (many points sharing an x, discs whose rims pass through points) and on random
+// points, for small discs, discs wider than the sheet and discs beside it.
+TEST(Diffusion, ASpotsParticlesAreThoseOfTheLoopOverEveryPoint) {
+    std::vector<Eigen::Vector3d> points;
+    for (int k = 0; k < 41 * 41; ++k) points.emplace_back(0.01 * (k % 41), 0.01 * (k / 41), 0.0);
+    for (int k = 0; k < 2000; ++k)
+        points.emplace_back(0.4 * uniformFromHash(3, 2 * k), 0.4 * uniformFromHash(3, 2 * k + 1),
+                            0.0);
+    const std::vector<int> byX = orderByX(points);
+    for (std::size_t k = 1; k < byX.size(); ++k)
+        ASSERT_TRUE(points[byX[k - 1]].x() < points[byX[k]].x() ||
+                    (points[byX[k - 1]].x() == points[byX[k]].x() && byX[k - 1] < byX[k]));
+    int discs = 0, narrow = 0;
+    for (int d = 0; d < 400; ++d) {
+        Eigen::Vector2d center(0.6 * uniformFromHash(4, 3 * d) - 0.1,
+                               0.6 * uniformFromHash(4, 3 * d + 1) - 0.1);
+        double radius = 0.2 * std::pow(uniformFromHash(4, 3 * d + 2), 3.0);
+        if (d % 4 == 0) {  // on a lattice point, its rim through others
+            center = points[(d * 37) % (41 * 41)].head<2>();
+            radius = 0.01 * (1 + d % 5);
+        }
+        if (d == 1) radius = 10.0;
+        std::vector<int> expected;
+        for (int i = 0; i < int(points.size()); ++i)
+            if ((points[i].head<2>() - center).norm() <= radius) expected.push_back(i);
+        const std::vector<int> found = pointsInDisc(points, byX, center, radius);
+        ASSERT_EQ(found, expected)
+            << "disc " << d << " at " << center.transpose() << " radius " << radius;
+        discs += !expected.empty();
+        narrow += 4 * expected.size() < points.size() && !expected.empty();
+    }
+    EXPECT_GT(narrow, 200);  // the run by x, not the loop over every point
+    EXPECT_GT(discs - narrow, 0);
+    // Without the order (or with another sheet's), every point is tested.
+    EXPECT_EQ(pointsInDisc(points, {}, Eigen::Vector2d(0.2, 0.2), 0.05),
+              pointsInDisc(points, byX, Eigen::Vector2d(0.2, 0.2), 0.05));
 }
 
 TEST(Coupling, FreeExpansionGivesStrainAlphaDeltaTheta) {

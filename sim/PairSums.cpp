@@ -18,35 +18,44 @@ constexpr int kTile = PairSumTiles::kTile;
 /// A group of one lane is summed as one particle: its rows would cost more than its own loop.
 constexpr int kFewestLanes = 2;
 
-/// Lanes [first, end)'s slots (where each one's x lies) of one row as at most two runs of
-/// consecutive slots; false where they are not.
-bool rowOf(const int* slot, int first, int end, int& runA, int& runB, int& split) {
-    runA = slot[first] - first, split = end;
-    for (int l = first + 1; l < end && split == end; ++l)
-        if (slot[l] - l != runA) split = l;
-    runB = split < end ? slot[split] - split : runA;
-    for (int l = first; l < end; ++l)
-        if (slot[l] < 0 || slot[l] - l != (l < split ? runA : runB)) return false;
-    return true;
-}
-
 /// A particle's bonds and lower copies among them.
 struct Shape {
     int bonds, lower;
     bool operator==(const Shape&) const = default;
 };
 
-/// Whether lanes [first, end) of tile t, of `bonds` bonds each, form a group; its rows if so.
-bool groupOf(const int* offsets, const int* slotOf, int t, int first, int end, int bonds,
-             std::vector<int>& a, std::vector<int>& b, std::vector<int>& split) {
-    a.resize(bonds), b.resize(bonds), split.resize(bonds);
-    for (int k = 0; k < bonds; ++k) {
-        int slot[kTile] = {};
-        for (int l = first; l < end; ++l) slot[l] = slotOf[offsets[kTile * t + l] + k];
-        if (!rowOf(slot, first, end, a[k], b[k], split[k])) return false;
+/// The rows of a group of a tile's lanes [first, end) grown one lane at a time: per row (its
+/// lanes' k-th bonds), where its slots lie as at most two runs of consecutive slots, run A (lane
+/// l's x at a + l) up to lane `split` and run B (b + l) from it.
+struct GroupRows {
+    std::vector<int> a, b, split;  ///< split < 0: one run so far
+    std::vector<int> slots;        ///< the next lane's slots, per row
+
+    /// Lane `first` alone: whether each of its bonds has a slot.
+    bool start(const int* offsets, const int* slotOf, int i, int lane, int bonds) {
+        a.assign(bonds, 0), b.assign(bonds, 0), split.assign(bonds, -1);
+        for (int k = 0; k < bonds; ++k) {
+            const int slot = slotOf[offsets[i] + k];
+            if (slot < 0) return false;
+            a[k] = b[k] = slot - lane;
+        }
+        return true;
     }
-    return true;
-}
+    /// Lane `lane` (particle i) added where each row keeps at most two runs; else unchanged.
+    bool extend(const int* offsets, const int* slotOf, int i, int lane) {
+        const int bonds = int(a.size());
+        slots.resize(bonds);
+        for (int k = 0; k < bonds; ++k) {
+            const int slot = slotOf[offsets[i] + k];
+            slots[k] = slot - lane;
+            const bool fits = split[k] < 0 ? true : slots[k] == b[k];
+            if (slot < 0 || !fits) return false;
+        }
+        for (int k = 0; k < bonds; ++k)
+            if (split[k] < 0 && slots[k] != a[k]) split[k] = lane, b[k] = slots[k];
+        return true;
+    }
+};
 
 /// Tile t as one union group (PairSumTiles::kUnion): its rows appended to `rows`, or false
 /// where it cannot be (a lane's bonds not in increasing offset, more than 64 life flags, a row
@@ -104,7 +113,7 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
     s.directedBonds = offsets[n];
     const int tiles = n / kTile;
     s.groupFirst.assign(tiles + 1, 0);
-    std::vector<int> a, b, split;
+    GroupRows rows;
     const auto shape = [&](int i) {
         return Shape{offsets[i + 1] - offsets[i], upperBegin[i] - offsets[i]};
     };
@@ -114,18 +123,19 @@ PairSumTiles PairSumTiles::build(const int* offsets, const int* upperBegin, cons
             const Shape own = shape(kTile * t + first);
             const bool vector = own.bonds > 0 && own.bonds <= kMostBonds;
             end = first + 1;
-            while (vector && end < kTile && shape(kTile * t + end) == own &&
-                   groupOf(offsets, slotOf, t, first, end + 1, own.bonds, a, b, split))
-                ++end;
+            if (vector && rows.start(offsets, slotOf, kTile * t + first, first, own.bonds))
+                while (end < kTile && shape(kTile * t + end) == own &&
+                       rows.extend(offsets, slotOf, kTile * t + end, end))
+                    ++end;
             Group group{std::uint8_t(first), std::uint8_t(end), 0, std::uint8_t(own.lower), -1};
-            if (vector && end - first >= kFewestLanes &&
-                groupOf(offsets, slotOf, t, first, end, own.bonds, a, b, split)) {
+            if (vector && end - first >= kFewestLanes) {
                 group.bonds = std::uint8_t(own.bonds), group.rowFirst = int(s.rows.size());
                 group.regular = 2 * own.lower == own.bonds;
                 for (int k = 0; k < own.bonds; ++k) {
                     const unsigned lanes = ((1u << (end - first)) - 1u) << first;
-                    s.rows.push_back({a[k], split[k] < end ? b[k] : a[k],
-                                      std::uint8_t(lanes & ((1u << split[k]) - 1u))});
+                    const int split = rows.split[k] < 0 ? end : rows.split[k];
+                    s.rows.push_back(
+                        {rows.a[k], rows.b[k], std::uint8_t(lanes & ((1u << split) - 1u))});
                     group.regular = group.regular && s.rows.back().fromA == lanes;
                 }
             }

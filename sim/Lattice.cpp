@@ -277,15 +277,54 @@ double seedSpacingOf(const SheetParams& sheet) {
 class TriangleLocator {
 public:
     TriangleLocator(const Lattice& lattice, double cell) : lattice_(lattice), cell_(cell) {
+        // Each triangle in the cells its bounding box covers...
+        std::unordered_map<std::int64_t, std::vector<int>> buckets;
+        long lowX = std::numeric_limits<long>::max(), lowY = lowX, highX = -lowX, highY = -lowX;
         for (int t = 0; t < int(lattice.triangles.size()); ++t) {
             Eigen::Vector2d lo = point(lattice.triangles[t][0]), hi = lo;
             for (int v : lattice.triangles[t]) {
                 lo = lo.cwiseMin(point(v));
                 hi = hi.cwiseMax(point(v));
             }
+            lowX = std::min(lowX, cellOf(lo.x())), highX = std::max(highX, cellOf(hi.x()));
+            lowY = std::min(lowY, cellOf(lo.y())), highY = std::max(highY, cellOf(hi.y()));
             for (long cy = cellOf(lo.y()); cy <= cellOf(hi.y()); ++cy)
                 for (long cx = cellOf(lo.x()); cx <= cellOf(hi.x()); ++cx)
-                    buckets_[key(cx, cy)].push_back(t);
+                    buckets[key(cx, cy)].push_back(t);
+        }
+        if (buckets.empty()) return;
+        // ... and, per cell of a dense grid one cell wider, the triangles of the nine cells
+        // around it in the order interpolate() looks at them, each once (a triangle covers up to
+        // four cells): a search of the nine cells' buckets and each of their triangles' weights
+        // was the set-up's largest item after the bonds.
+        firstX_ = lowX - 1, firstY_ = lowY - 1;
+        width_ = highX - lowX + 3, height_ = highY - lowY + 3;
+        near_.first.assign(std::size_t(width_ * height_) + 1, 0);
+        std::vector<int> seen(lattice.triangles.size(), -1);
+        for (long gy = 0; gy < height_; ++gy)
+            for (long gx = 0; gx < width_; ++gx) {
+                const long at = gy * width_ + gx;
+                for (long dy = -1; dy <= 1; ++dy)
+                    for (long dx = -1; dx <= 1; ++dx) {
+                        const auto it = buckets.find(key(firstX_ + gx + dx, firstY_ + gy + dy));
+                        if (it == buckets.end()) continue;
+                        for (const int t : it->second)
+                            if (seen[t] != at) seen[t] = int(at), near_.triangles.push_back(t);
+                    }
+                near_.first[at + 1] = int(near_.triangles.size());
+            }
+        // Each triangle's bounding box a millionth of a cell wider: a point outside it lies
+        // outside the triangle by a millionth of its size at least, far above the weights'
+        // rounding, so its smallest weight is negative.
+        const double margin = 1e-6 * cell;
+        boxes_.resize(lattice.triangles.size());
+        for (int t = 0; t < int(lattice.triangles.size()); ++t) {
+            Eigen::Vector2d lo = point(lattice.triangles[t][0]), hi = lo;
+            for (int v : lattice.triangles[t]) {
+                lo = lo.cwiseMin(point(v));
+                hi = hi.cwiseMax(point(v));
+            }
+            boxes_[t] = {lo.x() - margin, lo.y() - margin, hi.x() + margin, hi.y() + margin};
         }
     }
 
@@ -295,19 +334,26 @@ public:
         double bestInside = -std::numeric_limits<double>::infinity();
         Eigen::Vector3d bestWeights(1, 0, 0);
         int best = -1;
-        for (long dy = -1; dy <= 1; ++dy)
-            for (long dx = -1; dx <= 1; ++dx) {
-                const auto it = buckets_.find(key(cellOf(p.x()) + dx, cellOf(p.y()) + dy));
-                if (it == buckets_.end()) continue;
-                for (int t : it->second) {
-                    const Eigen::Vector3d w = weights(t, p);
-                    if (w.minCoeff() > bestInside) {
-                        bestInside = w.minCoeff();
-                        bestWeights = w;
-                        best = t;
-                    }
+        const long gx = cellOf(p.x()) - firstX_, gy = cellOf(p.y()) - firstY_;
+        if (gx < 0 || gy < 0 || gx >= width_ || gy >= height_) return 0.0;
+        const long at = gy * width_ + gx;
+        // The first of the largest smallest weight: a triangle seen again in a later cell cannot
+        // pass itself. First among the triangles whose box holds p: where one holds p (weights
+        // at least 0), no other can reach its smallest weight, and the answer is the same.
+        for (const bool boxed : {true, false}) {
+            for (int k = near_.first[at]; k < near_.first[at + 1]; ++k) {
+                const int t = near_.triangles[k];
+                if (boxed && !boxes_[t].holds(p)) continue;
+                const Eigen::Vector3d w = weights(t, p);
+                if (w.minCoeff() > bestInside) {
+                    bestInside = w.minCoeff();
+                    bestWeights = w;
+                    best = t;
                 }
             }
+            if (bestInside >= 0.0 || !boxed) break;
+            bestInside = -std::numeric_limits<double>::infinity(), best = -1;  // the rim
+        }
         if (best < 0) return 0.0;
         const Eigen::Vector3d w = bestWeights.cwiseMax(0.0) / bestWeights.cwiseMax(0.0).sum();
         const auto& [a, b, c] = lattice_.triangles[best];
@@ -332,7 +378,17 @@ private:
 
     const Lattice& lattice_;
     double cell_;
-    std::unordered_map<std::int64_t, std::vector<int>> buckets_;
+    long firstX_ = 0, firstY_ = 0, width_ = 0, height_ = 0;  ///< the grid of cells
+    struct Box {
+        double loX, loY, hiX, hiY;
+        bool holds(const Eigen::Vector2d& p) const {
+            return p.x() >= loX && p.x() <= hiX && p.y() >= loY && p.y() <= hiY;
+        }
+    };
+    std::vector<Box> boxes_;  ///< per triangle
+    struct {
+        std::vector<int> first{0}, triangles;  ///< per cell, CSR
+    } near_;
 };
 
 }  // namespace

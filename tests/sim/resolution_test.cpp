@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "sim/Lattice.h"
 #include "sim/Membrane.h"
+#include "sim/Random.h"
 #include "tests/sim/Peridynamic.h"
 
 using namespace rend::sim;
@@ -74,6 +76,55 @@ TEST(Resolution, ScatteredSpotsLandOnTheSameCentresAtEverySpacing) {
         return m.restPositions()[best];
     };
     EXPECT_LT((hottest(mc) - hottest(mf)).norm(), 0.1);
+}
+
+// The finer sheet's heights are the coarse lattice's values interpolated linearly in the
+// coarse triangle holding each particle, found by a search over every triangle (and, just
+// outside the coarse rim, extended from the least-outside triangle).
+TEST(Resolution, TheJitterIsInterpolatedInTheCoarseTriangleHoldingEachParticle) {
+    SheetParams coarse = sheetAt(0.04, 0.04).sheet;
+    coarse.perturbationAmplitude = 1e-3;
+    coarse.perturbationSeed = 5;
+    SheetParams fine = coarse;
+    fine.dx = 0.01;
+    const Lattice lc = generateLattice(coarse), lf = generateLattice(fine);
+    const std::vector<double> values = perturbationHeights(coarse, lc.positions);
+    std::vector<Eigen::Vector3d> at = lf.positions;
+    for (int k = 0; k < 300; ++k)  // and points off the lattice, some beyond the rim
+        at.emplace_back(1.2 * uniformFromHash(9, 2 * k) - 0.6,
+                        1.2 * uniformFromHash(9, 2 * k + 1) - 0.6, 0.0);
+    const std::vector<double> z = perturbationHeights(fine, at);
+    // Each triangle's weights at p; its smallest; its value there, weights clamped.
+    const auto weightsAt = [&](int t, const Eigen::Vector3d& p) {
+        const auto& [a, b, c] = lc.triangles[t];
+        Eigen::Matrix2d m;
+        m << (lc.positions[b] - lc.positions[a]).head<2>(),
+            (lc.positions[c] - lc.positions[a]).head<2>();
+        const Eigen::Vector2d uv = m.inverse() * (p - lc.positions[a]).head<2>();
+        return Eigen::Vector3d(1.0 - uv.sum(), uv.x(), uv.y());
+    };
+    const auto valueIn = [&](int t, const Eigen::Vector3d& p) {
+        const Eigen::Vector3d w = weightsAt(t, p).cwiseMax(0.0);
+        const auto& [a, b, c] = lc.triangles[t];
+        return (w[0] * values[a] + w[1] * values[b] + w[2] * values[c]) / w.sum();
+    };
+    int inside = 0, rim = 0;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+        double most = -std::numeric_limits<double>::infinity();
+        for (int t = 0; t < int(lc.triangles.size()); ++t)
+            most = std::max(most, weightsAt(t, at[i]).minCoeff());
+        if (most < -0.5) continue;
+        inside += most >= 0.0, rim += most < 0.0;
+        // The value of a triangle holding p (of any, where p is on an edge), or just outside the
+        // rim of one whose smallest weight is the largest (the least outside), extended.
+        bool matched = false;
+        for (int t = 0; t < int(lc.triangles.size()) && !matched; ++t)
+            matched = weightsAt(t, at[i]).minCoeff() >= most - 1e-12 &&
+                      std::abs(z[i] - valueIn(t, at[i])) <= 1e-12 * coarse.perturbationAmplitude;
+        ASSERT_TRUE(matched) << "point " << i << " at " << at[i].transpose() << ": " << z[i];
+    }
+    EXPECT_GT(inside, int(lf.positions.size()) / 2);
+    EXPECT_GT(rim, 20);
 }
 
 TEST(Resolution, TheJitterIsTheSameSurfaceSampledFiner) {

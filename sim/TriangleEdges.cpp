@@ -12,44 +12,35 @@ std::array<int, 2> sideOf(const std::array<int, 3>& triangle, int side, int firs
     return {std::min(a, b), std::max(a, b)};
 }
 
-/// trianglesAtCorners over every corner used.
-struct CornerTriangles {
-    std::vector<int> offsets, at;
-
-    explicit CornerTriangles(std::span<const std::array<int, 3>> triangles) {
-        int corners = 0;
-        for (const auto& t : triangles)
-            for (const int v : t) corners = std::max(corners, v + 1);
-        trianglesAtCorners(triangles, std::size_t(corners), offsets, at);
-    }
-};
-
 }  // namespace
 
 TriangleEdges triangleEdges(std::span<const std::array<int, 3>> triangles, int firstCorner) {
-    const CornerTriangles around(triangles);
+    int corners = 0;
+    for (const auto& t : triangles)
+        for (const int v : t) corners = std::max(corners, v + 1);
+    // Per lower corner, the edges numbered so far from it: their upper corners and numbers, in
+    // room for two sides of each triangle there (a side holds its lower corner).
+    std::vector<int> first(std::size_t(corners) + 1, 0);
+    for (const auto& t : triangles)
+        for (const int v : t) first[v + 1] += 2;
+    for (std::size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
+    std::vector<int> count(corners, 0), upper(first.back()), number(first.back());
     TriangleEdges edges;
     edges.ofTriangle.resize(triangles.size());
-    // The edge of an earlier side with the same pair: every side using the edge holds its lower
-    // corner, so the triangles there hold them all.
-    const auto earlier = [&](int t, int side, const std::array<int, 2>& pair) {
-        for (int k = around.offsets[pair[0]]; k < around.offsets[pair[0] + 1]; ++k) {
-            const int other = around.at[k];
-            if (other > t) break;
-            const int sides = other == t ? side : 3;
-            for (int s = 0; s < sides; ++s)
-                if (sideOf(triangles[other], s, firstCorner) == pair)
-                    return edges.ofTriangle[other][s];
-        }
-        return -1;
-    };
     for (int t = 0; t < int(triangles.size()); ++t)
         for (int side = 0; side < 3; ++side) {
-            const std::array<int, 2> pair = sideOf(triangles[t], side, firstCorner);
-            int e = earlier(t, side, pair);
-            if (e < 0) {
+            const auto [low, high] = sideOf(triangles[t], side, firstCorner);
+            const int* from = upper.data() + first[low];
+            const int* end = from + count[low];
+            const int* found = std::find(from, end, high);
+            int e;
+            if (found != end) {
+                e = number[found - upper.data()];
+            } else {  // the first side with this pair: a new edge
                 e = int(edges.ends.size());
-                edges.ends.push_back(pair);
+                edges.ends.push_back({low, high});
+                upper[first[low] + count[low]] = high, number[first[low] + count[low]] = e;
+                ++count[low];
             }
             edges.ofTriangle[t][side] = e;
         }

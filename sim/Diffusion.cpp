@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <optional>
 
@@ -105,13 +106,12 @@ std::vector<int> pointsInDisc(std::span<const Eigen::Vector3d> points, std::span
                                                 [&](int i) { return !(offset(i) >= -radius); });
         const auto last =
             std::partition_point(first, byX.end(), [&](int i) { return offset(i) <= radius; });
-        // A run of at most a quarter of the points, sorted back into index order; a wider
-        // disc is cheaper to find by testing every point.
+        // A run of at most a quarter of the points, those within sorted back into index order
+        // (a strip across the sheet holds several times the disc's); a wider disc is cheaper to
+        // find by testing every point.
         if (4 * (last - first) <= std::ptrdiff_t(points.size())) {
-            std::vector<int> near(first, last);
-            std::sort(near.begin(), near.end());
-            for (const int i : near)
-                if (within(i)) inside.push_back(i);
+            std::copy_if(first, last, std::back_inserter(inside), within);
+            std::sort(inside.begin(), inside.end());
             return inside;
         }
     }

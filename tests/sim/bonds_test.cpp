@@ -1,0 +1,81 @@
+// sim/Bonds.h: a particle's family is every other particle within the horizon, ascending, with
+// its rest length and weight, whatever the grid the search goes through (dense on a sheet,
+// hashed where the points lie far apart) and whatever the thread count.
+
+#include "sim/Bonds.h"
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "sim/Lattice.h"
+#include "sim/Random.h"
+
+namespace rend::sim {
+namespace {
+
+// The definition: every pair tested.
+BondFamilies everyPair(const std::vector<Eigen::Vector3d>& rest, double horizon) {
+    const double reach = horizon * (1.0 + 1e-9);
+    BondFamilies bonds;
+    bonds.offsets.push_back(0);
+    for (int i = 0; i < int(rest.size()); ++i) {
+        for (int j = 0; j < int(rest.size()); ++j) {
+            const double length = (rest[j] - rest[i]).norm();
+            if (j == i || !(length <= reach)) continue;
+            bonds.partners.push_back(j);
+            bonds.restLength.push_back(length);
+            bonds.weight.push_back(std::max(0.0, 1.0 - length / horizon));
+        }
+        bonds.offsets.push_back(int(bonds.partners.size()));
+    }
+    return bonds;
+}
+
+void expectSame(const BondFamilies& found, const BondFamilies& expected) {
+    ASSERT_EQ(found.offsets, expected.offsets);
+    ASSERT_EQ(found.partners, expected.partners);
+    ASSERT_EQ(found.restLength, expected.restLength);  // the same expression: the same bits
+    ASSERT_EQ(found.weight, expected.weight);
+}
+
+TEST(BondFamilies, AreEveryPairWithinTheHorizonOnASheet) {
+    SheetParams sheet;
+    sheet.size = {0.3, 0.2};
+    sheet.dx = 0.01;
+    const std::vector<Eigen::Vector3d> rest = generateLattice(sheet).positions;
+    for (const double horizon : {1.0, 1.5, 3.0}) {  // 1.0: bonds at exactly R kept
+        const BondFamilies expected = everyPair(rest, horizon * sheet.dx);
+        for (const int threads : {1, 2, 3}) {
+            omp_set_num_threads(threads);
+            expectSame(buildBondFamilies(rest, horizon * sheet.dx), expected);
+        }
+    }
+    omp_set_num_threads(omp_get_num_procs());
+}
+
+TEST(BondFamilies, AreEveryPairWithinTheHorizonAmongPointsFarApart) {
+    // Three clouds a thousand horizons apart (a dense grid of their bounding cells would hold a
+    // million cells per point), points stacked in z among them (the grid is in x and y).
+    std::vector<Eigen::Vector3d> rest;
+    const double horizon = 0.05;
+    for (int k = 0; k < 600; ++k) {
+        const Eigen::Vector3d centre(50.0 * (k % 3), -40.0 * (k % 3 == 1), 0.0);
+        rest.push_back(centre + Eigen::Vector3d(0.3 * uniformFromHash(21, 3 * k),
+                                                0.3 * uniformFromHash(21, 3 * k + 1),
+                                                0.1 * uniformFromHash(21, 3 * k + 2)));
+    }
+    const BondFamilies expected = everyPair(rest, horizon);
+    EXPECT_GT(expected.partners.size(), 3000u);
+    for (const int threads : {1, 2}) {
+        omp_set_num_threads(threads);
+        expectSame(buildBondFamilies(rest, horizon), expected);
+    }
+    omp_set_num_threads(omp_get_num_procs());
+    EXPECT_TRUE(buildBondFamilies({}, horizon).partners.empty());
+}
+
+}  // namespace
+}  // namespace rend::sim

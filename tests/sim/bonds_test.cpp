@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "sim/DamageState.h"
 #include "sim/Lattice.h"
 #include "sim/Random.h"
 
@@ -75,6 +76,41 @@ TEST(BondFamilies, AreEveryPairWithinTheHorizonAmongPointsFarApart) {
     }
     omp_set_num_threads(omp_get_num_procs());
     EXPECT_TRUE(buildBondFamilies({}, horizon).partners.empty());
+}
+
+// Breaking a bond breaks its copy at the other end, found by each family's bisection (findBond),
+// and nothing else; a bond whose other end holds no copy (a family built by hand) breaks alone.
+TEST(BondFamilies, ABrokenBondsCopyAtTheOtherEndBreaksWithIt) {
+    SheetParams sheet;
+    sheet.size = {0.1, 0.08};
+    sheet.dx = 0.01;
+    const Lattice lattice = generateLattice(sheet);
+    BondFamilies bonds = buildBondFamilies(lattice.positions, 2.0 * sheet.dx);
+    // Particle 5 loses its bond to its last partner: that partner's bond to 5 has no copy.
+    const int lonely = bonds.partners[bonds.offsets[6] - 1];
+    const int orphan = findBond(bonds, lonely, 5);
+    ASSERT_GE(orphan, 0);
+    bonds.partners.erase(bonds.partners.begin() + bonds.offsets[6] - 1);
+    bonds.restLength.erase(bonds.restLength.begin() + bonds.offsets[6] - 1);
+    bonds.weight.erase(bonds.weight.begin() + bonds.offsets[6] - 1);
+    for (std::size_t i = 6; i < bonds.offsets.size(); ++i) --bonds.offsets[i];
+    const int orphaned = orphan - (orphan >= bonds.offsets[6] ? 1 : 0);
+    ASSERT_EQ(bonds.partners[orphaned], 5);
+    for (int i = 0; i < bonds.particleCount(); ++i)
+        for (int b = bonds.offsets[i]; b < bonds.offsets[i + 1]; b += 3) {
+            DamageState damage(bonds, lattice.triangles);
+            damage.breakBond(b);
+            const int copy = findBond(bonds, bonds.partners[b], i);
+            EXPECT_EQ(copy < 0, b == orphaned);
+            int broken = 0;
+            for (int k = 0; k < int(bonds.directedCount()); ++k) broken += !damage.bondAlive()[k];
+            ASSERT_EQ(broken, copy < 0 ? 1 : 2) << "bond " << b << " of particle " << i;
+            EXPECT_FALSE(damage.bondAlive()[b]);
+            if (copy >= 0) EXPECT_FALSE(damage.bondAlive()[copy]);
+        }
+    DamageState damage(bonds, lattice.triangles);
+    damage.breakBond(orphaned);
+    EXPECT_EQ(std::count(damage.bondAlive().begin(), damage.bondAlive().end(), 0), 1);
 }
 
 }  // namespace

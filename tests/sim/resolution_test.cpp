@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "sim/Lattice.h"
 #include "sim/Membrane.h"
@@ -78,15 +79,22 @@ TEST(Resolution, ScatteredSpotsLandOnTheSameCentresAtEverySpacing) {
     EXPECT_LT((hottest(mc) - hottest(mf)).norm(), 0.1);
 }
 
+/// A sheet at dx 0.04 with a jitter of 1 mm (its own seed spacing) and the same sheet at dx 0.01,
+/// seeded by it.
+static std::pair<SheetParams, SheetParams> jitteredSheets(std::uint64_t seed) {
+    SheetParams coarse = sheetAt(0.04, 0.04).sheet;
+    coarse.perturbationAmplitude = 1e-3;
+    coarse.perturbationSeed = seed;
+    SheetParams fine = coarse;
+    fine.dx = 0.01;
+    return {coarse, fine};
+}
+
 // The finer sheet's heights are the coarse lattice's values interpolated linearly in the
 // coarse triangle holding each particle, found by a search over every triangle (and, just
 // outside the coarse rim, extended from the least-outside triangle).
 TEST(Resolution, TheJitterIsInterpolatedInTheCoarseTriangleHoldingEachParticle) {
-    SheetParams coarse = sheetAt(0.04, 0.04).sheet;
-    coarse.perturbationAmplitude = 1e-3;
-    coarse.perturbationSeed = 5;
-    SheetParams fine = coarse;
-    fine.dx = 0.01;
+    const auto [coarse, fine] = jitteredSheets(5);
     const Lattice lc = generateLattice(coarse), lf = generateLattice(fine);
     const std::vector<double> values = perturbationHeights(coarse, lc.positions);
     std::vector<Eigen::Vector3d> at = lf.positions;
@@ -128,11 +136,7 @@ TEST(Resolution, TheJitterIsInterpolatedInTheCoarseTriangleHoldingEachParticle) 
 }
 
 TEST(Resolution, TheJitterIsTheSameSurfaceSampledFiner) {
-    SheetParams coarse = sheetAt(0.04, 0.04).sheet;
-    coarse.perturbationAmplitude = 1e-3;
-    coarse.perturbationSeed = 3;
-    SheetParams fine = coarse;
-    fine.dx = 0.01;
+    const auto [coarse, fine] = jitteredSheets(3);
     const Lattice lc = generateLattice(coarse), lf = generateLattice(fine);
     const std::vector<double> zc = perturbationHeights(coarse, lc.positions);
     const std::vector<double> zf = perturbationHeights(fine, lf.positions);

@@ -443,6 +443,29 @@ struct Simd {
 
 #endif
 
+#if defined(__x86_64__)
+// The SIMD loop for the machine's width, from `begin` (a row's start) to the last whole row.
+template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate, int kN>
+int simdPairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end,
+              double& stiffest) {
+    constexpr bool kLookAhead = kLaw == BondLawKind::PowerLaw && kUpdate;
+    const bool skipFar = kLookAhead && in.skipFar;
+    if (skipFar && simdWidth() == 8)
+        return avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead, kN>(in, out, begin,
+                                                                                   end, stiffest);
+    if (skipFar && simdWidth() == 4)
+        return avx2x2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead, kN>(in, out, begin,
+                                                                                   end, stiffest);
+    if (simdWidth() == 8)
+        return avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, false, kN>(in, out, begin, end,
+                                                                              stiffest);
+    if (simdWidth() == 4)
+        return avx2x2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, false, kN>(in, out, begin, end,
+                                                                              stiffest);
+    return begin;
+}
+#endif
+
 template <BondLawKind kLaw, bool kTheta, bool kBreak, bool kUpdate>
 double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, int end) {
     double stiffest = in.stiffestKnown;
@@ -454,17 +477,15 @@ double pairs(const LinearPairInput& in, const LinearPairOutput& out, int begin, 
         stiffest = std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, row));
         begin = row;
     }
-    constexpr bool kLookAhead = kLaw == BondLawKind::PowerLaw && kUpdate;
-    if (kLookAhead && in.skipFar && simdWidth() == 8)
-        begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead>(in, out, begin, end,
-                                                                                stiffest);
-    else if (kLookAhead && in.skipFar && simdWidth() == 4)
-        begin = avx2x2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate, kLookAhead>(in, out, begin, end,
-                                                                                stiffest);
-    else if (simdWidth() == 8)
-        begin = avx512::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
-    else if (simdWidth() == 4)
-        begin = avx2x2::pairLoopSimd<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end, stiffest);
+    // The power law's exponent is 2, 3 or 4 here (PeridynamicBonds::vectorised).
+    if constexpr (kLaw != BondLawKind::PowerLaw)
+        begin = simdPairs<kLaw, kTheta, kBreak, kUpdate, 0>(in, out, begin, end, stiffest);
+    else if (in.powerN == 2.0)
+        begin = simdPairs<kLaw, kTheta, kBreak, kUpdate, 2>(in, out, begin, end, stiffest);
+    else if (in.powerN == 3.0)
+        begin = simdPairs<kLaw, kTheta, kBreak, kUpdate, 3>(in, out, begin, end, stiffest);
+    else if (in.powerN == 4.0)
+        begin = simdPairs<kLaw, kTheta, kBreak, kUpdate, 4>(in, out, begin, end, stiffest);
 #endif
     return std::max(stiffest, pairLoop<kLaw, kTheta, kBreak, kUpdate>(in, out, begin, end));
 }

@@ -65,6 +65,8 @@ struct Case {
     /// A sheet of 4 x 4 m: 160,801 particles, whose step streams from memory
     /// (streamsForces()): the tile sums' stores go around the caches.
     bool huge = false;
+    /// The power law's n (eq. 19): each whole exponent is its own SIMD loop.
+    double exponent = 4.0;
 };
 
 /// Particle i's force summed over both copies of its bonds, one at a time: the loop as the
@@ -116,6 +118,7 @@ TEST_P(PairLoop, HasTheBitsOfTheLoopOverBothCopies) {
     p.material.youngsModulus = 1e5;
     p.material.law = c.law;
     p.material.yieldStrain = 0.002;
+    p.material.powerLawExponent = c.exponent;
     if (c.breakable) p.material.fractureEnergy = 0.02;
     if (c.theta)
         p.material.expansion = 0.01, p.material.stiffnessLoss = 0.4, p.material.strengthLoss = 0.3;
@@ -575,7 +578,9 @@ INSTANTIATE_TEST_SUITE_P(
         Case{BondLawKind::Linear, true, true, false, true, true},
         Case{BondLawKind::PowerLaw, true, true, false, false, true},
         Case{BondLawKind::Elastoplastic, false, true, true, true, true},
-        Case{BondLawKind::Linear, true, true, false, true, false, true}));
+        Case{BondLawKind::Linear, true, true, false, true, false, true},
+        Case{BondLawKind::PowerLaw, true, true, false, true, true, false, 2.0},
+        Case{BondLawKind::PowerLaw, false, true, false, true, false, false, 3.0}));
 
 TEST(PartitionSlabs, OwnEveryParticleOnceAndHoldEveryPairTheyCompute) {
     const BondFamilies bonds = sheetBonds(0.3, 0.2, 1.5);

@@ -18,6 +18,16 @@ constexpr int kTile = PairSumTiles::kTile;
 /// A group of one lane is summed as one particle: its rows would cost more than its own loop.
 constexpr int kFewestLanes = 2;
 
+/// The lanes of a group's life flags per 64-bit word (bit k of lane l at l * bonds + k): all of
+/// them where they fit, else 4, 2 or 1 (the most that fit), so that a word's lanes are a power
+/// of two and its last lanes' flags never spill into the next.
+constexpr int lanesPerWordOf(int bonds, int lanes) {
+    if (bonds * lanes <= 64) return lanes;
+    int most = kTile / 2;
+    while (most > 1 && most * bonds > 64) most /= 2;
+    return most;
+}
+
 /// A particle's bonds and lower copies among them.
 struct Shape {
     int bonds, lower;
@@ -185,28 +195,32 @@ void gatherLoop(const PairGather& g, int begin, int end) {
 // Eight lanes: simdWidth() is 8 only with AVX-512 F and BW and BMI2.
 #define REND_TILE_TARGET gnu::target("avx2,avx512f,avx512bw,bmi2")
 
-/// Which of a group's bonds live, bit k of its lane l at l * bonds + k: one or two 64-byte
-/// loads (at most four lanes each where eight would not fit).
+/// Which of a group's bonds live, bit k of its lane l at l * bonds + k: a 64-byte load per word
+/// of lanesPerWordOf() lanes (eight lanes of up to eight bonds in one).
 struct GroupLife {
-    std::uint64_t low = 0, high = 0, stride = 0;
-    int lanesPerWord;
+    std::uint64_t flags[kTile] = {}, stride = 0;
+    int lanesPerWord, words;
 
     [[REND_TILE_TARGET]] static std::uint64_t word(const std::uint8_t* alive, int bytes) {
         const __mmask64 in = bytes >= 64 ? ~__mmask64(0) : (__mmask64(1) << bytes) - 1;
-        const __m512i flags = _mm512_maskz_loadu_epi8(in, alive);
-        return _mm512_test_epi8_mask(flags, flags);
+        const __m512i loaded = _mm512_maskz_loadu_epi8(in, alive);
+        return _mm512_test_epi8_mask(loaded, loaded);
     }
     [[REND_TILE_TARGET]] GroupLife(const std::uint8_t* alive, int bonds, int lanes) {
-        lanesPerWord = bonds * lanes <= 64 ? lanes : kTile / 2;
+        lanesPerWord = lanesPerWordOf(bonds, lanes);
+        words = (lanes + lanesPerWord - 1) / lanesPerWord;
         for (int l = 0; l < lanesPerWord; ++l) stride |= std::uint64_t(1) << (l * bonds);
-        low = word(alive, lanesPerWord * bonds);
-        if (lanesPerWord < lanes)
-            high = word(alive + lanesPerWord * bonds, (lanes - lanesPerWord) * bonds);
+        for (int w = 0; w < words; ++w)
+            flags[w] = word(alive + w * lanesPerWord * bonds,
+                            std::min(lanesPerWord, lanes - w * lanesPerWord) * bonds);
     }
     /// Bit l: the group's lane l's k-th bond lives.
     [[REND_TILE_TARGET]] unsigned of(int k) const {
         const std::uint64_t at = stride << k;
-        return unsigned(_pext_u64(low, at) | (_pext_u64(high, at) << lanesPerWord));
+        unsigned bits = 0;
+        for (int w = 0; w < words; ++w)
+            bits |= unsigned(_pext_u64(flags[w], at)) << (w * lanesPerWord);
+        return bits;
     }
 };
 
@@ -504,6 +518,27 @@ template <int kBonds>
     storeRun4(out + 12, x1, y1, z1);
 }
 
+/// sumRegularTileAvx2 for any count of bonds (a wide horizon's 12 to 64), its rows in a loop.
+[[gnu::target("avx2")]] void sumWideRegularTileAvx2(const PairGather& g,
+                                                    const PairSumTiles::Row* row, int bonds,
+                                                    double* out) {
+    __m256d sum[6];
+    for (__m256d& s : sum) s = _mm256_setzero_pd();
+    const std::ptrdiff_t y = g.stride;
+    for (int k = 0; k < bonds; ++k) {
+        const double* a = g.pairForce + row[k].atA;
+        const double* at[3] = {a, a + y, a + 2 * y};
+        for (int c = 0; c < 3; ++c)
+            for (int h = 0; h < 2; ++h) {
+                const __m256d f = _mm256_loadu_pd(at[c] + 4 * h);
+                __m256d& to = sum[2 * c + h];
+                to = k < bonds / 2 ? _mm256_sub_pd(to, f) : _mm256_add_pd(to, f);
+            }
+    }
+    storeRun4(out, sum[0], sum[2], sum[4]);
+    storeRun4(out + 12, sum[1], sum[3], sum[5]);
+}
+
 // Four lanes' masks and the other tiles (sumGroupTileAvx2, sumUnionTileAvx2): a tile of one
 // group whose bonds do not all live or whose rows lie in two runs, and a tile across a lattice
 // row's ends, by masked rows as the AVX-512 sumTile's, each lane's terms in its bond order, a
@@ -570,26 +605,28 @@ struct HalfSums {
     return _mm256_blendv_pd(_mm256_loadu_pd(b + 4 * h), fromRunA, laneMask(fromA >> (4 * h)));
 }
 
-/// The AVX-512 GroupLife's words from lifeBits(): a group's eight lanes' flags in one word
-/// where they are at most 64, else in a word per half of four lanes (the horizon-2.2 square
-/// sheet's 12 bonds each).
+/// The AVX-512 GroupLife's words from lifeBits(), lanesPerWordOf() lanes each (eight lanes of up
+/// to eight bonds in one word).
 struct GroupLifeAvx2 {
-    std::uint64_t low = 0, high = 0, stride = 0;
-    int lanesPerWord;
+    std::uint64_t flags[kTile] = {}, stride = 0;
+    int lanesPerWord, words;
 
     [[REND_TILE_AVX2]] GroupLifeAvx2(const PairGather& g, const PairSumTiles& s, int base,
                                      int bonds) {
-        lanesPerWord = bonds * kTile <= 64 ? kTile : kTile / 2;
+        lanesPerWord = lanesPerWordOf(bonds, kTile);
+        words = kTile / lanesPerWord;
         for (int l = 0; l < lanesPerWord; ++l) stride |= std::uint64_t(1) << (l * bonds);
         const int count = lanesPerWord * bonds;
-        low = lifeBits(g.alive + base, count, base + 64 <= s.directedBonds);
-        if (lanesPerWord < kTile)
-            high = lifeBits(g.alive + base + count, count, base + count + 64 <= s.directedBonds);
+        for (int w = 0, at = base; w < words; ++w, at += count)
+            flags[w] = lifeBits(g.alive + at, count, at + 64 <= s.directedBonds);
     }
     /// Bit l: lane l's k-th bond lives.
     [[REND_TILE_AVX2]] unsigned of(int k) const {
         const std::uint64_t at = stride << k;
-        return unsigned(_pext_u64(low, at) | (_pext_u64(high, at) << lanesPerWord));
+        unsigned bits = 0;
+        for (int w = 0; w < words; ++w)
+            bits |= unsigned(_pext_u64(flags[w], at)) << (w * lanesPerWord);
+        return bits;
     }
 };
 
@@ -652,12 +689,13 @@ struct GroupLifeAvx2 {
     const int base = kTile * t;
     if (one.endLane == kTile) {
         if (one.lower == PairSumTiles::kUnion) return sumUnionTileAvx2(g, s, one, t);
-        if (one.regular && (one.bonds == 8 || one.bonds == 6 || one.bonds == 12) &&
+        if (one.regular && one.bonds >= 4 &&
             allLiving(g.alive + g.offsets[base], kTile * one.bonds)) {
             const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
             if (one.bonds == 8) return sumRegularTileAvx2<8>(g, rows, g.forceOf(base));
             if (one.bonds == 12) return sumRegularTileAvx2<12>(g, rows, g.forceOf(base));
-            return sumRegularTileAvx2<6>(g, rows, g.forceOf(base));
+            if (one.bonds == 6) return sumRegularTileAvx2<6>(g, rows, g.forceOf(base));
+            return sumWideRegularTileAvx2(g, rows, one.bonds, g.forceOf(base));
         }
         if (one.bonds > 0 && one.bonds <= PairSumTiles::kMostBonds)
             return sumGroupTileAvx2(g, s, one, t);

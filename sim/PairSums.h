@@ -22,7 +22,7 @@ namespace rend::sim {
 /// row is one group), or one union group (below) where a lattice's row ends.
 struct PairSumTiles {
     static constexpr int kTile = 8;
-    static constexpr int kMostBonds = 16;  ///< a group's life flags in two 64-byte loads
+    static constexpr int kMostBonds = 64;  ///< a lane's life flags in one 64-bit word
     std::vector<int> groupFirst;           ///< per whole tile, and one past the last
     struct Group {
         std::uint8_t firstLane, endLane, bonds, lower;  ///< bonds 0: one particle at a time

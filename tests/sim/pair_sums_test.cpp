@@ -148,7 +148,9 @@ void expectSameBits(const Sums& sums, int begin, int end) {
 
 struct Case {
     LatticeKind lattice;
-    double horizon;  ///< in dx: 1.5 gives 8 bonds (square) or 6 (hexagonal); 2.2 gives 12
+    /// In dx: 1.5 gives 8 bonds (square) or 6 (hexagonal); 2.2 gives 12; 3 gives 28 (square;
+    /// a lane's flags in a word of two lanes) or 36 (hexagonal: a word a lane).
+    double horizon;
 };
 
 class PairSums : public ::testing::TestWithParam<Case> {};
@@ -172,11 +174,45 @@ TEST_P(PairSums, HaveTheBitsOfOneParticleAtATime) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Lattices, PairSums,
-                         ::testing::Values(Case{LatticeKind::Square, 1.5},
-                                           Case{LatticeKind::Hexagonal, 1.5},
-                                           Case{LatticeKind::Square, 2.2},
-                                           Case{LatticeKind::Hexagonal, 2.5}));
+INSTANTIATE_TEST_SUITE_P(
+    Lattices, PairSums,
+    ::testing::Values(Case{LatticeKind::Square, 1.5}, Case{LatticeKind::Hexagonal, 1.5},
+                      Case{LatticeKind::Square, 2.2}, Case{LatticeKind::Hexagonal, 2.5},
+                      Case{LatticeKind::Square, 3.0}, Case{LatticeKind::Hexagonal, 3.0}));
+
+// Wide horizons: a tile inside a lattice's row is one group of eight lanes however many bonds
+// its particles have, up to PairSumTiles::kMostBonds (their sums by rows, checked bit for bit
+// above); past it, one particle at a time.
+TEST(PairSumTiles, TilesOfUpToSixtyFourBondsAreGroupsOfEightLanes) {
+    for (const auto& [kind, horizon, bonds] :
+         {std::tuple{LatticeKind::Square, 3.0, 28}, std::tuple{LatticeKind::Hexagonal, 3.0, 36},
+          std::tuple{LatticeKind::Square, 4.0, 48}, std::tuple{LatticeKind::Square, 4.5, 68}}) {
+        const BondFamilies family = sheetBonds(0.6, 0.3, kind, horizon);
+        const BondPairs pairs = buildBondPairs(family);
+        const Layout layout = ringOfRows(family, pairs, 1 << 20);
+        const PairSumTiles tiles =
+            PairSumTiles::build(family.offsets.data(), pairs.upperBegin.data(), layout.slot.data(),
+                                family.partners.data(), family.particleCount());
+        int whole = 0, interior = 0;
+        for (int t = 0; t + 1 < int(tiles.groupFirst.size()); ++t) {
+            bool inside = true;  // every lane with the interior's bonds
+            for (int i = kTile * t; i < kTile * (t + 1); ++i)
+                inside = inside && family.offsets[i + 1] - family.offsets[i] == bonds;
+            if (!inside) continue;
+            ++interior;
+            const PairSumTiles::Group& g = tiles.groups[tiles.groupFirst[t]];
+            whole += tiles.groupFirst[t + 1] - tiles.groupFirst[t] == 1 && g.endLane == kTile &&
+                     g.bonds == bonds;
+        }
+        ASSERT_GT(interior, 20) << "horizon " << horizon;
+        // A few tiles of full lanes hold rows in more than two runs of slots.
+        if (bonds <= PairSumTiles::kMostBonds)
+            EXPECT_GE(whole, interior * 9 / 10)
+                << "horizon " << horizon << ", " << bonds << " bonds";
+        else
+            EXPECT_EQ(whole, 0) << "horizon " << horizon << ", " << bonds << " bonds";
+    }
+}
 
 /// A square sheet of 24 + 1 particles per row and its sums' tiles: many tiles lie inside a
 /// row, the others cross its end.

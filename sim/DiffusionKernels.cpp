@@ -103,7 +103,7 @@ void DiffusionTiles::setUpRows() {
     for (int t = 0; t < tiles; ++t) {
         const int first = tileBegin[t] / kTile, end = tileBegin[t + 1] / kTile;
         const int rows = end - first;
-        bool plain = rows == 6 || rows == 8 || rows == 12;
+        bool plain = rows > 0 && rows <= 255;
         for (int row = first; row < end && plain; ++row)
             plain = rowRun[row] >= 0 && rowClass[row] >= 0;
         plainTile[t] = plain ? std::uint8_t(rows) : 0;
@@ -212,9 +212,10 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
 /// compared on its own. (Copied into one word on the stack, 4 + 2 bytes stored and 8 loaded
 /// could not be forwarded: the load waited for the stores, half of diffusion's cpu-clock
 /// samples on a hexagonal sheet.)
+/// kRows 0: `count` rows, eight bytes at a time.
 template <int kRows>
-inline bool allRowsLive(const std::uint8_t* rows) {
-    static_assert(kRows == 6 || kRows == 8 || kRows == 12);
+inline bool allRowsLive(const std::uint8_t* rows, int count) {
+    static_assert(kRows == 0 || kRows == 6 || kRows == 8 || kRows == 12);
     const auto all = [rows]<class Word>(int at, Word) {
         Word w;
         std::memcpy(&w, rows + at, sizeof w);
@@ -222,7 +223,13 @@ inline bool allRowsLive(const std::uint8_t* rows) {
     };
     if constexpr (kRows == 6) return all(0, std::uint32_t()) && all(4, std::uint16_t());
     if constexpr (kRows == 8) return all(0, std::uint64_t());
-    return all(0, std::uint64_t()) && all(8, std::uint32_t());
+    if constexpr (kRows == 12) return all(0, std::uint64_t()) && all(8, std::uint32_t());
+    int k = 0;
+    for (; k + 8 <= count; k += 8)
+        if (!all(k, std::uint64_t())) return false;
+    for (; k < count; ++k)
+        if (rows[k] != 0xff) return false;
+    return true;
 }
 
 // A plain tile (DiffusionTiles::plainTile) of kRows rows in two halves of four lanes: its rows'
@@ -232,20 +239,22 @@ inline bool allRowsLive(const std::uint8_t* rows) {
 // 10^4, 5.27 -> 1.66 at 10^6). Six rows are the hexagonal sheets' (every shipped scene's),
 // twelve a square sheet's of horizon 2.2; taking them here rather than by the loop below took
 // crack_path_sources on its hexagonal lattice at 10^4 (linear, one Zen 3 core, fastest of eight
-// alternate runs) from 19.3 to 18.1 ns per particle-step, the same bits.
+// alternate runs) from 19.3 to 18.1 ns per particle-step, the same bits. kRows 0: a wider
+// horizon's `count` rows, in a loop (a square sheet of horizon 3, 28 rows: by the loop below,
+// diffusion was a quarter of a step's instructions).
 template <int kRows>
 [[gnu::target("avx2")]] inline void diffusePlainTile(const DiffusionTiles& d, const double* theta,
                                                      double* next, __m256d step, __m256i laneBit,
-                                                     int t) {
+                                                     int t, int count = kRows) {
     const __m256d ownLow = _mm256_loadu_pd(theta + 8 * t);
     const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
     __m256d low = _mm256_setzero_pd(), high = low;
     const int first = d.tileBegin[t] / 8;
     // Every bond lives: the same adds, without the masks (cpu-clock samples on one Zen 3 core,
     // crack_path_sources at 10^4, linear: 0.18 of the pair kernel's -> 0.14).
-    if (allRowsLive<kRows>(d.livingRows.data() + first)) {
+    if (allRowsLive<kRows>(d.livingRows.data() + first, count)) {
 #pragma GCC unroll 12
-        for (int k = 0; k < kRows; ++k) {
+        for (int k = 0; k < count; ++k) {
             const int row = first + k;
             const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
             const double* other = theta + d.rowRun[row];
@@ -259,7 +268,7 @@ template <int kRows>
         return;
     }
 #pragma GCC unroll 12
-    for (int k = 0; k < kRows; ++k) {
+    for (int k = 0; k < count; ++k) {
         const int row = first + k, lives = d.livingRows[row];
         const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
         const double* other = theta + d.rowRun[row];
@@ -316,8 +325,11 @@ template <int kRows>
             case 12:
                 diffusePlainTile<12>(d, theta, next, step, laneBit, t);
                 continue;
-            default:
+            case 0:
                 break;
+            default:
+                diffusePlainTile<0>(d, theta, next, step, laneBit, t, d.plainTile[t]);
+                continue;
         }
         for (int half = 0; half < 8; half += 4) {
             const __m256d own = _mm256_loadu_pd(theta + 8 * t + half);

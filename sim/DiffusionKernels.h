@@ -29,9 +29,10 @@ struct DiffusionTiles {
     std::vector<double> classRate, classUnit;
     std::vector<std::uint16_t> rateSteps;
     static constexpr int kSteppedRate = -2;
-    /// Per tile: its number of rows where it has 6, 8 or 12, each a run with one rate (a
-    /// regular lattice's interior: hexagonal, square, square of horizon 2.2), whose sums are
-    /// straight code (the AVX-512 sums' for 8 rows only); else 0.
+    /// Per tile: its number of rows (up to 255) where each is a run with one rate (a regular
+    /// lattice's interior), whose sums are straight code for 6, 8 or 12 rows (hexagonal,
+    /// square, square of horizon 2.2) and a plain loop for the others (the AVX-512 sums' for 8
+    /// rows only); else 0.
     std::vector<std::uint8_t> plainTile;
     /// Per row, bit l: slot kTile row + l's bond lives (refresh()); 0 for a pad.
     std::vector<std::uint8_t> livingRows;

@@ -107,7 +107,7 @@ TEST_P(DiffusionTileSums, SumEachParticlesLivingBondsInOrder) {
     if (rates == Rates::Random) EXPECT_EQ(tiles.classedRows(), 0);
     if (rates != Rates::Random) EXPECT_GT(tiles.classedRows(), allRows * 3 / 4);
     if (rates == Rates::Stepped) EXPECT_GT(stepped, allRows / 2);
-    // Tiles of 6, 8 or 12 runs with one rate each sum as straight code (plainTile): never where
+    // Tiles of runs with one rate each sum as plain code (plainTile): never where
     // each rate is its own (DiffusionTilesPlain.SumAsTheLoopDoes below takes that path).
     const int tileCount = int(tiles.tileBegin.size()) - 1;
     ASSERT_EQ(int(tiles.plainTile.size()), tileCount);
@@ -144,7 +144,8 @@ INSTANTIATE_TEST_SUITE_P(
 
 // A regular sheet's own rates (one exact value per direction) make most tiles plain: a run with
 // one rate per row, summed as straight code with the rows' living bytes read as words; six rows
-// on a hexagonal sheet, eight on a square one, twelve on a square one of horizon 2.2. With some
+// on a hexagonal sheet, eight on a square one, twelve on a square one of horizon 2.2 (and 28 and
+// 36 at horizon 3, by a loop). With some
 // bonds dead, and tiles with all of them living, the sums keep the loop's bits.
 struct PlainCase {
     LatticeKind lattice;
@@ -199,7 +200,9 @@ TEST_P(DiffusionTilesPlain, SumAsTheLoopDoes) {
 INSTANTIATE_TEST_SUITE_P(Lattices, DiffusionTilesPlain,
                          ::testing::Values(PlainCase{LatticeKind::Hexagonal, 1.5, 6},
                                            PlainCase{LatticeKind::Square, 1.5, 8},
-                                           PlainCase{LatticeKind::Square, 2.2, 12}));
+                                           PlainCase{LatticeKind::Square, 2.2, 12},
+                                           PlainCase{LatticeKind::Square, 3.0, 28},
+                                           PlainCase{LatticeKind::Hexagonal, 3.0, 36}));
 
 // A diffusion that stepped before some bonds broke steps afterwards as one built on the broken
 // bonds does: its copy of which bonds live follows DamageState::version().

@@ -17,7 +17,9 @@
 // after their steps: ns per particle-step on 1 thread. Last, crack_path_sources as shipped
 // (hexagonal, adaptive steps, frame by frame) for the linear and elastoplastic laws, with the
 // adaptive step's failure approach rate measured in the next step's force pass and in a pass of
-// its own (Membrane::setApproachInPass(false)): what that saves. Then seconds a frame of
+// its own (Membrane::setApproachInPass(false)): what that saves. Then crack_path_sources (square,
+// linear) with its bonds reaching 1.5, 2.2 and 3 dx (8, 12 and 28 bonds a particle): ns per
+// particle-step and per bond, and its diffusion alone. Then seconds a frame of
 // foil_tear_heat at final quality with a cache file a frame, written by the run itself and by a
 // thread of its own while the next frame simulates (app/CacheWriter.h).
 //
@@ -287,6 +289,22 @@ double lawRow(const std::string& scene, const char* law, double side = 0.0, int 
     return ns;
 }
 
+/// ns per particle-step (and per directed bond) on 1 thread of crack_path_sources, square, dt
+/// 1e-4, linear law, with the bonds reaching `horizon` dx: its bonds per particle, ns per
+/// particle-step, and the diffusion alone after the steps.
+std::array<double, 3> horizonRow(double horizon) {
+    const rend::Scene s =
+        rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/crack_path_sources.toml",
+                        {"sheet.lattice=\"square\"", "time.dt=1e-4", "material.law=\"linear\"",
+                         "sheet.horizon=" + std::to_string(horizon)});
+    rend::sim::Membrane membrane(s.sim);
+    omp_set_num_threads(1);
+    for (int k = 0; k < 100; ++k) membrane.step();
+    const double ns = nsPerParticleStep(membrane, 1, 2.0);
+    return {double(membrane.bonds().directedCount()) / membrane.particleCount(), ns,
+            diffusionNsPerParticleStep(membrane, 1.0)};
+}
+
 /// ns per particle-step on 1 thread of crack_path_sources as shipped (its hexagonal lattice,
 /// time.dt = "adaptive") with [material] law = `law`, stepped frame by frame (Membrane::advanceTo)
 /// with the failure approach rate measured in the next step's force pass, and in a pass of its
@@ -539,6 +557,16 @@ int main(int argc, char** argv) {
         const std::array<double, 2> ns = adaptiveRow(law);
         std::printf("%-32s %18.1f %18.1f %9.0f%%\n", law, ns[0], ns[1],
                     100.0 * (1.0 - ns[0] / ns[1]));
+    }
+    std::printf(
+        "\nns per particle-step, 1 thread, crack_path_sources (square, 10,201 particles, dt 1e-4, "
+        "linear, theta and breaking) by horizon\n%-10s %10s %14s %12s %16s\n",
+        "horizon", "bonds/p", "ns/p-step", "ns/bond", "diffusion alone");
+    for (const double horizon : {1.5, 2.2, 3.0}) {
+        const std::array<double, 3> h = horizonRow(horizon);
+        std::printf("%-10.1f %10.2f %14.1f %12.2f %16.1f\n", horizon, h[0], h[1], h[1] / h[0],
+                    h[2]);
+        std::fflush(stdout);
     }
     const std::array<double, 2> frameSeconds = cacheRow();
     std::printf(

@@ -1,0 +1,75 @@
+// The steps that scripts/bench_instructions.sh counts under callgrind: a scene's membrane, square
+// lattice, dt 1e-4, one bond law (as bench_speed's per-law rows), stepped `warm` times and then
+// `steps` times inside measuredSteps(), the one function the script has callgrind count
+// (--toggle-collect), so that neither the set-up nor the first steps' allocations are counted.
+// Prints the particles and steps, which the script divides the counts by.
+//
+//   build/bench_instructions SCENE LAW [WARM STEPS]   (scenes/SCENE; 5 and 20 by default)
+
+#include <omp.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "app/Scene.h"
+#include "sim/Membrane.h"
+
+namespace {
+
+/// The counted steps: callgrind collects from this function's entry to its return.
+[[gnu::noinline]] void measuredSteps(rend::sim::Membrane& membrane, int steps) {
+    for (int k = 0; k < steps; ++k) membrane.step();
+    asm volatile("" ::: "memory");  // not folded into the caller's loop
+}
+
+/// `text` as a whole number in [low, high], or a message and false.
+bool countOf(const char* what, const char* text, int low, int high, int& out) {
+    char* end = nullptr;
+    const long value = std::strtol(text, &end, 10);
+    if (end == text || *end != '\0' || value < low || value > high) {
+        std::fprintf(stderr, "bench_instructions: %s '%s': expected a whole number from %d to %d\n",
+                     what, text, low, high);
+        return false;
+    }
+    out = int(value);
+    return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 3 && argc != 5) {
+        std::fprintf(stderr,
+                     "bench_instructions: expected SCENE LAW [WARM STEPS] (e.g. stretch.toml "
+                     "linear 5 20)\n");
+        return 2;
+    }
+    int warm = 5, steps = 20;
+    if (argc == 5 && (!countOf("WARM", argv[3], 1, 100000, warm) ||
+                      !countOf("STEPS", argv[4], 1, 100000, steps)))
+        return 2;
+    const std::string law = argv[2];
+    if (law != "linear" && law != "power_law" && law != "elastoplastic") {
+        std::fprintf(stderr,
+                     "bench_instructions: LAW '%s': expected linear, power_law or elastoplastic\n",
+                     argv[2]);
+        return 2;
+    }
+    const std::vector<std::string> sets = {"sheet.lattice=\"square\"", "time.dt=1e-4",
+                                           "material.law=\"" + law + "\""};
+    try {
+        const rend::Scene s =
+            rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/" + argv[1], sets);
+        omp_set_num_threads(1);
+        rend::sim::Membrane membrane(s.sim);
+        for (int k = 0; k < warm; ++k) membrane.step();
+        measuredSteps(membrane, steps);
+        std::printf("particles %d steps %d\n", membrane.particleCount(), steps);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_instructions: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

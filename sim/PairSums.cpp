@@ -493,29 +493,29 @@ template <int kBonds, bool kRegular>
 template <int kBonds>
 [[gnu::target("avx2")]] void sumRegularTileAvx2(const PairGather& g, const PairSumTiles::Row* row,
                                                 double* out) {
-    __m256d x0 = _mm256_setzero_pd(), y0 = x0, z0 = x0, x1 = x0, y1 = x0, z1 = x0;
-    const int y = g.stride, z = 2 * g.stride;
-#pragma GCC unroll 8
-    for (int k = 0; k < kBonds; ++k) {
-        const double* a = g.pairForce + row[k].atA;
-        if (k < kBonds / 2) {
-            x0 = _mm256_sub_pd(x0, _mm256_loadu_pd(a)),
-            x1 = _mm256_sub_pd(x1, _mm256_loadu_pd(a + 4));
-            y0 = _mm256_sub_pd(y0, _mm256_loadu_pd(a + y));
-            y1 = _mm256_sub_pd(y1, _mm256_loadu_pd(a + y + 4));
-            z0 = _mm256_sub_pd(z0, _mm256_loadu_pd(a + z));
-            z1 = _mm256_sub_pd(z1, _mm256_loadu_pd(a + z + 4));
-        } else {
-            x0 = _mm256_add_pd(x0, _mm256_loadu_pd(a)),
-            x1 = _mm256_add_pd(x1, _mm256_loadu_pd(a + 4));
-            y0 = _mm256_add_pd(y0, _mm256_loadu_pd(a + y));
-            y1 = _mm256_add_pd(y1, _mm256_loadu_pd(a + y + 4));
-            z0 = _mm256_add_pd(z0, _mm256_loadu_pd(a + z));
-            z1 = _mm256_add_pd(z1, _mm256_loadu_pd(a + z + 4));
+    const double* at[kBonds];
+#pragma GCC unroll 12
+    for (int k = 0; k < kBonds; ++k) at[k] = g.pairForce + row[k].atA;
+    __m256d sum[6];
+    // x, then y, then z: each axis's offset hidden from the compiler (an empty asm), so that
+    // its loads address [row + axis], the rows in registers. Bonds and axes in one unrolled
+    // loop had it keep a pointer per row and axis, spilled to the stack (169 -> 149
+    // instructions a tile, scripts/bench_instructions.sh).
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+        std::ptrdiff_t axis = c * std::ptrdiff_t(g.stride);
+        asm("" : "+r"(axis));
+        __m256d low = _mm256_setzero_pd(), high = low;
+#pragma GCC unroll 12
+        for (int k = 0; k < kBonds; ++k) {
+            const __m256d a = _mm256_loadu_pd(at[k] + axis), b = _mm256_loadu_pd(at[k] + axis + 4);
+            low = k < kBonds / 2 ? _mm256_sub_pd(low, a) : _mm256_add_pd(low, a);
+            high = k < kBonds / 2 ? _mm256_sub_pd(high, b) : _mm256_add_pd(high, b);
         }
+        sum[2 * c] = low, sum[2 * c + 1] = high;
     }
-    storeRun4(out, x0, y0, z0);
-    storeRun4(out + 12, x1, y1, z1);
+    storeRun4(out, sum[0], sum[2], sum[4]);
+    storeRun4(out + 12, sum[1], sum[3], sum[5]);
 }
 
 /// sumRegularTileAvx2 for any count of bonds (a wide horizon's 12 to 64), its rows in a loop.

@@ -242,47 +242,69 @@ inline bool allRowsLive(const std::uint8_t* rows, int count) {
 // alternate runs) from 19.3 to 18.1 ns per particle-step, the same bits. kRows 0: a wider
 // horizon's `count` rows, in a loop (a square sheet of horizon 3, 28 rows: by the loop below,
 // diffusion was a quarter of a step's instructions).
+/// Lanes 0-3 of a mask, all bits set where bit l of the index is (four lanes' life flags).
+struct alignas(32) LaneMasks {
+    std::uint64_t lanes[16][4];
+    constexpr LaneMasks() : lanes() {
+        for (int bits = 0; bits < 16; ++bits)
+            for (int l = 0; l < 4; ++l) lanes[bits][l] = (bits >> l & 1) ? ~std::uint64_t(0) : 0;
+    }
+};
+constexpr LaneMasks kLaneMasks;
+
+/// diffusePlainTile's tiles with a dead bond: each row's terms under its lanes' life flags. A
+/// function of its own: inline, the compiler computed both paths' common terms before the
+/// branch between them, and kept eight rows' terms on the stack (157 -> 119 instructions a
+/// square tile, scripts/bench_instructions.sh). Each half's mask is one load from a table.
 template <int kRows>
-[[gnu::target("avx2")]] inline void diffusePlainTile(const DiffusionTiles& d, const double* theta,
-                                                     double* next, __m256d step, __m256i laneBit,
-                                                     int t, int count = kRows) {
+[[gnu::target("avx2"), gnu::noinline]] void diffuseMaskedPlainTile(const DiffusionTiles& d,
+                                                                   const double* theta,
+                                                                   double* next, __m256d step,
+                                                                   int t, int count) {
     const __m256d ownLow = _mm256_loadu_pd(theta + 8 * t);
     const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
     __m256d low = _mm256_setzero_pd(), high = low;
     const int first = d.tileBegin[t] / 8;
-    // Every bond lives: the same adds, without the masks (cpu-clock samples on one Zen 3 core,
-    // crack_path_sources at 10^4, linear: 0.18 of the pair kernel's -> 0.14).
-    if (allRowsLive<kRows>(d.livingRows.data() + first, count)) {
-#pragma GCC unroll 12
-        for (int k = 0; k < count; ++k) {
-            const int row = first + k;
-            const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
-            const double* other = theta + d.rowRun[row];
-            low = _mm256_add_pd(low,
-                                _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other), ownLow)));
-            high = _mm256_add_pd(
-                high, _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other + 4), ownHigh)));
-        }
-        _mm256_storeu_pd(next + 8 * t, _mm256_add_pd(ownLow, _mm256_mul_pd(step, low)));
-        _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
-        return;
-    }
 #pragma GCC unroll 12
     for (int k = 0; k < count; ++k) {
         const int row = first + k, lives = d.livingRows[row];
         const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
         const double* other = theta + d.rowRun[row];
-        const __m256i bitsLow = _mm256_set1_epi64x(lives),
-                      bitsHigh = _mm256_set1_epi64x(lives >> 4);
         const __m256d aliveLow =
-            _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bitsLow, laneBit), laneBit));
+            _mm256_load_pd(reinterpret_cast<const double*>(kLaneMasks.lanes[lives & 15]));
         const __m256d aliveHigh =
-            _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(bitsHigh, laneBit), laneBit));
+            _mm256_load_pd(reinterpret_cast<const double*>(kLaneMasks.lanes[lives >> 4]));
         const __m256d termLow = _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other), ownLow));
         const __m256d termHigh =
             _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other + 4), ownHigh));
         low = _mm256_blendv_pd(low, _mm256_add_pd(low, termLow), aliveLow);
         high = _mm256_blendv_pd(high, _mm256_add_pd(high, termHigh), aliveHigh);
+    }
+    _mm256_storeu_pd(next + 8 * t, _mm256_add_pd(ownLow, _mm256_mul_pd(step, low)));
+    _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
+}
+
+template <int kRows>
+[[gnu::target("avx2")]] inline void diffusePlainTile(const DiffusionTiles& d, const double* theta,
+                                                     double* next, __m256d step, int t,
+                                                     int count = kRows) {
+    const int first = d.tileBegin[t] / 8;
+    // Every bond lives: the same adds, without the masks (cpu-clock samples on one Zen 3 core,
+    // crack_path_sources at 10^4, linear: 0.18 of the pair kernel's -> 0.14).
+    if (!allRowsLive<kRows>(d.livingRows.data() + first, count))
+        return diffuseMaskedPlainTile<kRows>(d, theta, next, step, t, count);
+    const __m256d ownLow = _mm256_loadu_pd(theta + 8 * t);
+    const __m256d ownHigh = _mm256_loadu_pd(theta + 8 * t + 4);
+    __m256d low = _mm256_setzero_pd(), high = low;
+#pragma GCC unroll 12
+    for (int k = 0; k < count; ++k) {
+        const int row = first + k;
+        const __m256d rate = _mm256_set1_pd(d.classRate[d.rowClass[row]]);
+        const double* other = theta + d.rowRun[row];
+        low =
+            _mm256_add_pd(low, _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other), ownLow)));
+        high = _mm256_add_pd(
+            high, _mm256_mul_pd(rate, _mm256_sub_pd(_mm256_loadu_pd(other + 4), ownHigh)));
     }
     _mm256_storeu_pd(next + 8 * t, _mm256_add_pd(ownLow, _mm256_mul_pd(step, low)));
     _mm256_storeu_pd(next + 8 * t + 4, _mm256_add_pd(ownHigh, _mm256_mul_pd(step, high)));
@@ -317,18 +339,18 @@ template <int kRows>
     for (int t = firstTile; t < lastTile; ++t) {
         switch (d.plainTile[t]) {
             case 6:
-                diffusePlainTile<6>(d, theta, next, step, laneBit, t);
+                diffusePlainTile<6>(d, theta, next, step, t);
                 continue;
             case 8:
-                diffusePlainTile<8>(d, theta, next, step, laneBit, t);
+                diffusePlainTile<8>(d, theta, next, step, t);
                 continue;
             case 12:
-                diffusePlainTile<12>(d, theta, next, step, laneBit, t);
+                diffusePlainTile<12>(d, theta, next, step, t);
                 continue;
             case 0:
                 break;
             default:
-                diffusePlainTile<0>(d, theta, next, step, laneBit, t, d.plainTile[t]);
+                diffusePlainTile<0>(d, theta, next, step, t, d.plainTile[t]);
                 continue;
         }
         for (int half = 0; half < 8; half += 4) {

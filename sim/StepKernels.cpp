@@ -107,8 +107,12 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 // local `below`, as kickDriftAvx512's: through the references, every store to x and v read the
 // input's pointers again, and each lane's test of the floor read and wrote `below` in memory, a
 // chain of store-to-load forwards (cpu-clock samples on those instructions: a third of the
-// loop's).
-[[gnu::target("avx2")]] int kickDriftAvx2(const KickDrift& input, int begin, int end,
+// loop's). One mass for the sheet (kOne) and a floor (kFloor) are constants of the loop: a
+// branch on the one, and the other's test where there is no floor, were 12 of a quad's 76
+// instructions (scripts/bench_instructions.sh); the lanes below the floor are gathered in a
+// vector and asked once.
+template <bool kOne, bool kFloor>
+[[gnu::target("avx2")]] int kickQuadsAvx2(const KickDrift& input, int begin, int end,
                                           bool& belowFloor) {
     const KickDrift k = input;
     bool below = false;
@@ -118,9 +122,12 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     const __m256d gravity[3] = {_mm256_setr_pd(g[0], g[1], g[2], g[0]),
                                 _mm256_setr_pd(g[1], g[2], g[0], g[1]),
                                 _mm256_setr_pd(g[2], g[0], g[1], g[2])};
-    constexpr int kZLanes[3] = {0b0100, 0b0010, 0b1001};  // where the z's sit
+    // Where the z's sit in each lane.
+    const __m256d zLanes[3] = {_mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0)),
+                               _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0)),
+                               _mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, -1))};
+    __m256d belowLanes = _mm256_setzero_pd();
     // One mass for the sheet: one broadcast, the mass array unread (kickDriftAvx512's).
-    const bool one = k.oneMass > 0.0;
     const __m256d oneMass = _mm256_set1_pd(k.oneMass);
     int i = begin;
     for (; i + 4 <= end; i += 4) {
@@ -129,7 +136,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             continue;
         }
         __m256d mass[3] = {oneMass, oneMass, oneMass};
-        if (!one) {
+        if constexpr (!kOne) {
             const double* m = k.mass + i;
             mass[0] = _mm256_setr_pd(m[0], m[0], m[0], m[1]);
             mass[1] = _mm256_setr_pd(m[1], m[1], m[2], m[2]);
@@ -147,11 +154,23 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             _mm256_storeu_pd(v, vel);
             const __m256d to = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_mul_pd(dt, vel));
             _mm256_storeu_pd(x, to);
-            below |= (_mm256_movemask_pd(_mm256_cmp_pd(to, floor, _CMP_NGE_UQ)) & kZLanes[lane]);
+            if constexpr (kFloor)
+                belowLanes = _mm256_or_pd(
+                    belowLanes, _mm256_and_pd(_mm256_cmp_pd(to, floor, _CMP_NGE_UQ), zLanes[lane]));
         }
     }
+    below = below || _mm256_movemask_pd(belowLanes) != 0;
     belowFloor = belowFloor || below;
     return i;
+}
+
+int kickDriftAvx2(const KickDrift& k, int begin, int end, bool& belowFloor) {
+    const bool one = k.oneMass > 0.0, floor = k.floor != -std::numeric_limits<double>::infinity();
+    if (floor)
+        return one ? kickQuadsAvx2<true, true>(k, begin, end, belowFloor)
+                   : kickQuadsAvx2<false, true>(k, begin, end, belowFloor);
+    return one ? kickQuadsAvx2<true, false>(k, begin, end, belowFloor)
+               : kickQuadsAvx2<false, false>(k, begin, end, belowFloor);
 }
 
 // Eight free particles are twenty-four doubles, three lanes of eight, the masses and gravity
@@ -205,20 +224,25 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 // Four particles at a time, lane k the scalar loop's chain k (guardScalar's): the same bits.
 // A quad with a particle that is not free is visited one by one into the same chains. The
 // scalar loop had 0.12 of a step's cpu-clock samples on one Zen 3 core (crack_path_sources at
-// 10^4, linear law), this one 0.05.
-[[gnu::target("avx2")]] GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
+// 10^4, linear law), this one 0.05. One mass for the sheet (kOne) and gravity (kGravity) are
+// constants of the loop, and the lanes' indices a vector that moves on by four: a branch on
+// each, and the index converted and broadcast, were 10 of a quad's 58 instructions
+// (scripts/bench_instructions.sh).
+template <bool kOne, bool kGravity>
+[[gnu::target("avx2")]] GuardSums guardQuadsAvx2(const GuardInput& g, int begin, int end) {
     GuardSums s;
     const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(g.limitSquared);
     const __m256d gx = _mm256_set1_pd(g.gravity[0]), gy = _mm256_set1_pd(g.gravity[1]);
     const __m256d gz = _mm256_set1_pd(g.gravity[2]), sign = _mm256_set1_pd(-0.0);
-    const __m256d iota = _mm256_setr_pd(0.0, 1.0, 2.0, 3.0);
+    const __m256d four = _mm256_set1_pd(4.0);
     __m256d kinetic = _mm256_setzero_pd(), gravityPower = _mm256_setzero_pd();
     __m256d best = _mm256_setzero_pd(), bestAt = _mm256_set1_pd(-1.0);  // indices, exact
     GuardPart p[4];
-    const bool one = g.oneMass > 0.0;
     const __m256d oneMass = _mm256_set1_pd(g.oneMass);
+    const __m256d halfOneMass = _mm256_mul_pd(half, oneMass);
     int i = begin;
-    for (; i + 4 <= end; i += 4) {
+    __m256d at = _mm256_add_pd(_mm256_set1_pd(double(i)), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
+    for (; i + 4 <= end; i += 4, at = _mm256_add_pd(at, four)) {
         if (!allFree(g.constraint + i, 4)) {
             double k[4], w[4];
             _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
@@ -237,9 +261,10 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
             _mm256_add_pd(_mm256_mul_pd(vx, vx), _mm256_mul_pd(vy, vy)), _mm256_mul_pd(vz, vz));
         const int bad = _mm256_movemask_pd(_mm256_cmp_pd(ss, limit, _CMP_NLE_UQ));
         if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(unsigned(bad));
-        const __m256d m = one ? oneMass : _mm256_loadu_pd(g.mass + i);
-        kinetic = _mm256_add_pd(kinetic, _mm256_mul_pd(_mm256_mul_pd(half, m), ss));
-        if (g.hasGravity) {
+        const __m256d m = kOne ? oneMass : _mm256_loadu_pd(g.mass + i);
+        const __m256d halfMass = kOne ? halfOneMass : _mm256_mul_pd(half, m);
+        kinetic = _mm256_add_pd(kinetic, _mm256_mul_pd(halfMass, ss));
+        if constexpr (kGravity) {
             const __m256d along = _mm256_add_pd(
                 _mm256_add_pd(_mm256_mul_pd(gx, vx), _mm256_mul_pd(gy, vy)), _mm256_mul_pd(gz, vz));
             gravityPower =
@@ -247,11 +272,11 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
         }
         const __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
         best = _mm256_blendv_pd(best, ss, faster);
-        bestAt = _mm256_blendv_pd(bestAt, _mm256_add_pd(_mm256_set1_pd(double(i)), iota), faster);
+        bestAt = _mm256_blendv_pd(bestAt, at, faster);
     }
-    double k[4], w[4], speeds[4], at[4];
+    double k[4], w[4], speeds[4], lanes[4];
     _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
-    _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(at, bestAt);
+    _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(lanes, bestAt);
     for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
     for (; i < end; ++i) guardVisit(g, i, p[0], s);
     const auto total = [&](double GuardPart::*field) {
@@ -262,10 +287,20 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     s.gravityPower = total(&GuardPart::gravityPower);
     for (int l = 0; l < 4; ++l) {
         const bool higher = speeds[l] > s.maxSpeedSquared;
-        const bool tie = speeds[l] == s.maxSpeedSquared && int(at[l]) < s.fastest;
-        if (at[l] >= 0.0 && (higher || tie)) s.maxSpeedSquared = speeds[l], s.fastest = int(at[l]);
+        const bool tie = speeds[l] == s.maxSpeedSquared && int(lanes[l]) < s.fastest;
+        if (lanes[l] >= 0.0 && (higher || tie))
+            s.maxSpeedSquared = speeds[l], s.fastest = int(lanes[l]);
     }
     return s;
+}
+
+GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
+    const bool one = g.oneMass > 0.0;
+    if (g.hasGravity)
+        return one ? guardQuadsAvx2<true, true>(g, begin, end)
+                   : guardQuadsAvx2<false, true>(g, begin, end);
+    return one ? guardQuadsAvx2<true, false>(g, begin, end)
+               : guardQuadsAvx2<false, false>(g, begin, end);
 }
 
 // Four at a time; NaN and inf are bad (not <= the largest double), a NaN lane keeps the max.
@@ -432,7 +467,8 @@ bool kickDrift(const KickDrift& k, int begin, int end) {
         begin = kickDriftAvx2(k, begin, end, below);
 #endif
     for (int i = begin; i < end; ++i) below |= kickDriftOne(k, i);
-    return below;
+    // No floor (-inf): nothing is below it, whatever its height (the four-lane loop does not ask).
+    return below && k.floor != -std::numeric_limits<double>::infinity();
 }
 
 }  // namespace rend::sim

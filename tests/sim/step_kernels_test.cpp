@@ -263,12 +263,21 @@ TEST(GuardSums, TheScalarLoopAndAvx2AddInTheSameFourChains) {
                      30.0,
                      {0.3, -0.2, -9.81},
                      true};
-        for (const int begin : {0, 3}) {
-            const GuardSums got = guardSums(g, begin, n), want = fourChainGuard(g, begin, n);
-            EXPECT_GT(got.kinetic, 0.0);
-            EXPECT_EQ(got.kinetic, want.kinetic) << n << " " << begin;
-            EXPECT_EQ(got.gravityPower, want.gravityPower) << n << " " << begin;
-            EXPECT_EQ(got.boundaryPower, want.boundaryPower) << n << " " << begin;
+        // With and without gravity (the four-lane loop's two forms); without, its power is 0.
+        for (const bool gravity : {true, false}) {
+            g.hasGravity = gravity;
+            if (!gravity) g.gravity[0] = g.gravity[1] = g.gravity[2] = 0.0;
+            for (const int begin : {0, 3}) {
+                const GuardSums got = guardSums(g, begin, n), want = fourChainGuard(g, begin, n);
+                EXPECT_GT(got.kinetic, 0.0);
+                EXPECT_EQ(got.kinetic, want.kinetic) << n << " " << begin;
+                EXPECT_EQ(got.gravityPower, want.gravityPower) << n << " " << begin;
+                EXPECT_EQ(got.boundaryPower, want.boundaryPower) << n << " " << begin;
+                const GuardSums naive = naiveGuard(g, n);
+                if (begin == 0) {
+                    EXPECT_EQ(got.fastest, naive.fastest) << n << " " << gravity;
+                }
+            }
         }
     }
 }

@@ -41,7 +41,7 @@ struct KickDrift {
 
 /// Particles [begin, end): v += h (f / m + g - damping v) for the free ones, the pinned at rest,
 /// the driven at their boundary's velocity; then x += dt v. Returns whether a free particle's z
-/// is not >= k.floor afterwards (NaN counts).
+/// is not >= k.floor afterwards (NaN counts); false without a floor (k.floor = -inf).
 bool kickDrift(const KickDrift& k, int begin, int end);
 
 /// What the blow-up guard (sim/BlowUpGuard.h) reads of a range of particles after a step.

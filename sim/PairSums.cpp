@@ -649,31 +649,47 @@ struct GroupLifeAvx2 {
     storeHalves(g.forceOf(kTile * t), sum);
 }
 
-/// Half h of a union row's x (or y, z: `at` after): run A's load, runs B and C blended in.
-[[REND_TILE_AVX2]] inline __m256d unionHalf(const double* pairForce,
-                                            const PairSumTiles::UnionRow& r, int at, int h) {
-    __m256d v = _mm256_loadu_pd(pairForce + r.at[0] + at + 4 * h);
-    for (int run = 1; run < 3; ++run)
-        if (const unsigned from = unsigned(r.from[run]) >> (4 * h) & 15u; from != 0)
-            v = _mm256_blendv_pd(v, _mm256_loadu_pd(pairForce + r.at[run] + at + 4 * h),
-                                 laneMask(from));
-    return v;
-}
+/// Half h of a union row: where its lanes lie in runs A, B and C, and which lanes come from B and
+/// from C (masks asked for once for the three axes).
+struct UnionHalf {
+    const double *a, *b, *c;
+    bool fromB, fromC;
+    __m256d maskB, maskC;
+
+    [[REND_TILE_AVX2]] UnionHalf(const double* pairForce, const PairSumTiles::UnionRow& r, int h) {
+        const unsigned lanesB = unsigned(r.from[1]) >> (4 * h) & 15u;
+        const unsigned lanesC = unsigned(r.from[2]) >> (4 * h) & 15u;
+        a = pairForce + r.at[0] + 4 * h, b = pairForce + r.at[1] + 4 * h;
+        c = pairForce + r.at[2] + 4 * h;
+        fromB = lanesB != 0, fromC = lanesC != 0;
+        maskB = fromB ? laneMask(lanesB) : _mm256_setzero_pd();
+        maskC = fromC ? laneMask(lanesC) : _mm256_setzero_pd();
+    }
+    /// The half's x (or y, z: `at` after): run A's load, runs B and C blended in.
+    [[REND_TILE_AVX2]] __m256d at(std::ptrdiff_t axis) const {
+        __m256d v = _mm256_loadu_pd(a + axis);
+        if (fromB) v = _mm256_blendv_pd(v, _mm256_loadu_pd(b + axis), maskB);
+        if (fromC) v = _mm256_blendv_pd(v, _mm256_loadu_pd(c + axis), maskC);
+        return v;
+    }
+};
 
 /// A tile across a lattice row's ends (PairSumTiles::kUnion), as sumUnionTile.
 [[REND_TILE_AVX2]] void sumUnionTileAvx2(const PairGather& g, const PairSumTiles& s,
                                          const PairSumTiles::Group& one, int t) {
     const int base = g.offsets[kTile * t], flags = g.offsets[kTile * (t + 1)] - base;
     const std::uint64_t life = lifeBits(g.alive + base, flags, base + 64 <= s.directedBonds);
+    const std::ptrdiff_t y = g.stride, z = 2 * y;
     HalfSums sum{};
     for (int q = one.rowFirst; q < one.rowFirst + one.bonds; ++q) {
         const PairSumTiles::UnionRow& r = s.unionRows[q];
         const unsigned on = unsigned(_pdep_u64(_pext_u64(life, r.select), r.having));
+        const bool minus = r.minus;
         for (int h = 0; h < 2; ++h)
-            if ((on >> (4 * h) & 15u) != 0)
-                addHalf(sum, h, unionHalf(g.pairForce, r, 0, h),
-                        unionHalf(g.pairForce, r, g.stride, h),
-                        unionHalf(g.pairForce, r, 2 * g.stride, h), on, r.minus);
+            if ((on >> (4 * h) & 15u) != 0) {
+                const UnionHalf lanes(g.pairForce, r, h);
+                addHalf(sum, h, lanes.at(0), lanes.at(y), lanes.at(z), on, minus);
+            }
     }
     storeHalves(g.forceOf(kTile * t), sum);
 }

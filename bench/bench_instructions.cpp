@@ -1,10 +1,11 @@
 // The steps that scripts/bench_instructions.sh counts under callgrind: a scene's membrane, square
-// lattice, dt 1e-4, one bond law (as bench_speed's per-law rows), stepped `warm` times and then
-// `steps` times inside measuredSteps(), the one function the script has callgrind count
+// lattice (or another), dt 1e-4, one bond law (as bench_speed's per-law rows), stepped `warm` times
+// and then `steps` times inside measuredSteps(), the one function the script has callgrind count
 // (--toggle-collect), so that neither the set-up nor the first steps' allocations are counted.
 // Prints the particles and steps, which the script divides the counts by.
 //
-//   build/bench_instructions SCENE LAW [WARM STEPS]   (scenes/SCENE; 5 and 20 by default)
+//   build/bench_instructions SCENE LAW [WARM STEPS [LATTICE]]   (scenes/SCENE; 5 and 20 steps,
+//   the square lattice by default; LATTICE square, hexagonal, or scene: the scene's own)
 
 #include <omp.h>
 
@@ -40,14 +41,21 @@ bool countOf(const char* what, const char* text, int low, int high, int& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 3 && argc != 5) {
+    if (argc != 3 && argc != 5 && argc != 6) {
         std::fprintf(stderr,
-                     "bench_instructions: expected SCENE LAW [WARM STEPS] (e.g. stretch.toml "
-                     "linear 5 20)\n");
+                     "bench_instructions: expected SCENE LAW [WARM STEPS [LATTICE]] (e.g. "
+                     "stretch.toml linear 5 20 square)\n");
+        return 2;
+    }
+    const std::string lattice = argc == 6 ? argv[5] : "square";
+    if (lattice != "square" && lattice != "hexagonal" && lattice != "scene") {
+        std::fprintf(stderr,
+                     "bench_instructions: LATTICE '%s': expected square, hexagonal or scene\n",
+                     argv[5]);
         return 2;
     }
     int warm = 5, steps = 20;
-    if (argc == 5 && (!countOf("WARM", argv[3], 1, 100000, warm) ||
+    if (argc >= 5 && (!countOf("WARM", argv[3], 1, 100000, warm) ||
                       !countOf("STEPS", argv[4], 1, 100000, steps)))
         return 2;
     const std::string law = argv[2];
@@ -57,8 +65,8 @@ int main(int argc, char** argv) {
                      argv[2]);
         return 2;
     }
-    const std::vector<std::string> sets = {"sheet.lattice=\"square\"", "time.dt=1e-4",
-                                           "material.law=\"" + law + "\""};
+    std::vector<std::string> sets = {"time.dt=1e-4", "material.law=\"" + law + "\""};
+    if (lattice != "scene") sets.push_back("sheet.lattice=\"" + lattice + "\"");
     try {
         const rend::Scene s =
             rend::loadScene(std::string(REND_SOURCE_DIR) + "/scenes/" + argv[1], sets);

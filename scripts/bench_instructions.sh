@@ -17,6 +17,7 @@
 #   SCENES="stretch" LAWS="linear" STEPS=5 scripts/bench_instructions.sh
 #   BASE=/path/to/other/build scripts/bench_instructions.sh   that build's counts beside, and
 #                                                              the change
+#   LATTICE=hexagonal scripts/bench_instructions.sh           (or scene: each scene's own)
 # Needs valgrind (apt-get install valgrind); says so and exits 0 without it. Each run of 10^4
 # particles and 25 steps takes 10-20 s.
 set -euo pipefail
@@ -26,6 +27,10 @@ laws=${LAWS:-"linear power_law elastoplastic"}
 warm=${WARM:-5}
 steps=${STEPS:-20}
 build=${BUILD:-build}
+lattice=${LATTICE:-square}
+# Passed on only when asked for: a BASE build from before LATTICE takes four arguments.
+lattice_arg=()
+[[ -n ${LATTICE:-} ]] && lattice_arg=("$LATTICE")
 command -v valgrind >/dev/null || {
     echo "bench_instructions: valgrind not installed (apt-get install valgrind)"
     exit 0
@@ -43,7 +48,7 @@ count() {
     local binary=$1 scene=$2 law=$3 out=$4
     local shape
     shape=$(valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*measuredSteps*' \
-        --callgrind-out-file="$tmp/cg" "$binary" "$scene.toml" "$law" "$warm" "$steps" \
+        --callgrind-out-file="$tmp/cg" "$binary" "$scene.toml" "$law" "$warm" "$steps" "${lattice_arg[@]}" \
         2>"$tmp/valgrind.txt") || {
         echo "bench_instructions: $binary $scene $law failed:" >&2
         tail -5 "$tmp/valgrind.txt" >&2
@@ -77,8 +82,8 @@ print(particles, program * scale, *(totals[p] * scale for p in totals))
 EOF
 }
 
-printf 'instructions per particle-step (callgrind), %s steps counted after %s, one thread\n' \
-    "$steps" "$warm"
+printf 'instructions per particle-step (callgrind), %s steps counted after %s, one thread, %s lattice\n' \
+    "$steps" "$warm" "$lattice"
 printf '%-20s %-14s %9s %8s %8s %8s %8s %9s %8s %8s\n' scene law particles total pair sums kick \
     diffusion guard other
 for scene in $scenes; do

@@ -18,6 +18,9 @@
 #   BASE=/path/to/other/build scripts/bench_instructions.sh   that build's counts beside, and
 #                                                              the change
 #   LATTICE=hexagonal scripts/bench_instructions.sh           (or scene: each scene's own)
+#   DT=scene LATTICE=scene WARM=2 STEPS=1 scripts/bench_instructions.sh
+#        the scenes as shipped, frame by frame (adaptive steps: the kick in its own pass); WARM
+#        and STEPS then count frames
 # Needs valgrind (apt-get install valgrind); says so and exits 0 without it. Each run of 10^4
 # particles and 25 steps takes 10-20 s.
 set -euo pipefail
@@ -28,9 +31,11 @@ warm=${WARM:-5}
 steps=${STEPS:-20}
 build=${BUILD:-build}
 lattice=${LATTICE:-square}
+dt=${DT:-1e-4}
 # Passed on only when asked for: a BASE build from before LATTICE takes four arguments.
 lattice_arg=()
-[[ -n ${LATTICE:-} ]] && lattice_arg=("$LATTICE")
+[[ -n ${LATTICE:-} || -n ${DT:-} ]] && lattice_arg=("$lattice")
+[[ -n ${DT:-} ]] && lattice_arg+=("$DT")
 command -v valgrind >/dev/null || {
     echo "bench_instructions: valgrind not installed (apt-get install valgrind)"
     exit 0
@@ -82,8 +87,8 @@ print(particles, program * scale, *(totals[p] * scale for p in totals))
 EOF
 }
 
-printf 'instructions per particle-step (callgrind), %s steps counted after %s, one thread, %s lattice\n' \
-    "$steps" "$warm" "$lattice"
+printf 'instructions per particle-step (callgrind), %s steps counted after %s, one thread, %s lattice, dt %s\n' \
+    "$steps" "$warm" "$lattice" "$dt"
 printf '%-20s %-14s %9s %8s %8s %8s %8s %9s %8s %8s\n' scene law particles total pair sums kick \
     diffusion guard other
 for scene in $scenes; do

@@ -19,7 +19,7 @@ check() {
 }
 
 for args in "stretch.toml" "stretch.toml cubic" "stretch.toml linear 5" \
-    "stretch.toml linear 0 3" "stretch.toml linear 2 x" "stretch.toml linear 2 2 cubic"; do
+    "stretch.toml linear 0 3" "stretch.toml linear 2 x" "stretch.toml linear 2 2 cubic" "stretch.toml linear 2 2 square -1"; do
     check "bench_instructions refuses '$args'" bash -c \
         '"$1"/bench_instructions $2 >/dev/null 2>"$3"; [[ $? -eq 2 ]] && grep -q expected "$3"' \
         _ "$build" "$args" "$(mktemp)"

@@ -7,7 +7,8 @@
 # summed by part:
 #   pair       the pair kernel (eqs. 18-20, 27-28: each bond's force once, into its slot)
 #   sums       each particle's sum of its bonds' forces (sim/PairSums)
-#   kick       the kick and drift (symplectic Euler)
+#   kick       the kick and drift (symplectic Euler; with the guard's sums where they are taken
+#              in its loop, as with adaptive steps)
 #   diffusion  eq. 25 (sim/Diffusion, sim/DiffusionKernels)
 #   guard      the blow-up guard's sample (sim/BlowUpGuard, sim/StepKernels)
 #   other      the rest (the step's bookkeeping, fracture's proposals, OpenMP)
@@ -66,7 +67,7 @@ text = open(sys.argv[1]).read()
 particles, steps = map(int, re.match(r"particles (\d+) steps (\d+)", sys.argv[2]).groups())
 parts = [("pair", r"pairLoop|PairKernel|linearPairForces|simdPairs|plasticForces"),
          ("sums", r"gatherTiles|gatherParticle|gatherLoop|gatherPairForces|sum\w*Tile"),
-         ("kick", r"kickDrift|kickQuads"),
+         ("kick", r"kickDrift|kickQuads|kickGuard"),
          ("diffusion", r"diffuse|Diffusion"),
          ("guard", r"guard|BlowUpGuard")]
 totals = dict.fromkeys([p for p, _ in parts] + ["other"], 0)

@@ -128,8 +128,15 @@ void BlowUpGuard::beginMotion(int first, int last) {
 
 void BlowUpGuard::sampleMotion(const State& s, int block) {
     const int begin = motionFirst_ + block * kBlock, end = std::min(motionLast_, begin + kBlock);
-    motion_[block] = sampleOf(
-        guardMotionSums(guardInput(s, speedLimit_, gravity_, hasGravity_, false), begin, end));
+    recordMotion(block, guardMotionSums(motionInput(s), begin, end));
+}
+
+GuardInput BlowUpGuard::motionInput(const State& s) const {
+    return guardInput(s, speedLimit_, gravity_, hasGravity_, false);
+}
+
+void BlowUpGuard::recordMotion(int block, const GuardSums& sums) {
+    motion_[block] = sampleOf(sums);
 }
 
 BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {

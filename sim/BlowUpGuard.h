@@ -21,6 +21,7 @@
 
 #include "sim/Domain.h"
 #include "sim/Params.h"
+#include "sim/StepKernels.h"
 
 namespace rend::sim {
 
@@ -106,6 +107,10 @@ public:
     /// check, v, force, mass and constraint must not change, or forgetMotion() must be called.
     void beginMotion(int first, int last);
     void sampleMotion(const State& state, int block);
+    /// What sampleMotion() sums over, for a pass that takes the sums as it moves the particles
+    /// (kickDriftSampled); recordMotion() keeps a block's, in place of sampleMotion().
+    GuardInput motionInput(const State& state) const;
+    void recordMotion(int block, const GuardSums& sums);
     void endMotion() { motionReady_ = true; }
     void forgetMotion() { motionReady_ = false; }
 

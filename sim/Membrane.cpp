@@ -267,10 +267,13 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
     const int blocks = (end_ - begin_ + kBlock - 1) / kBlock;
     const BlowUpGuard::State moved = motionState();
     guard_.beginMotion(begin_, end_);
+    const GuardInput sample = guard_.motionInput(moved);
+    // Each block's sums taken in the kick's own loop (kickDriftSampled: sampleMotion()'s bits).
     const auto move = [&](int b, bool& below) {
-        below =
-            kickDrift(k, begin_ + b * kBlock, std::min(end_, begin_ + (b + 1) * kBlock)) || below;
-        guard_.sampleMotion(moved, b);
+        bool under = false;
+        guard_.recordMotion(b, kickDriftSampled(k, sample, begin_ + b * kBlock,
+                                                std::min(end_, begin_ + (b + 1) * kBlock), under));
+        below = under || below;
     };
     bool below = false;
     if (wakesTeam(end_ - begin_ >= kParallelThreshold)) {

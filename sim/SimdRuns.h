@@ -25,16 +25,21 @@ namespace rend::sim {
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
 }
 
-[[gnu::always_inline, gnu::target("avx2")]] inline void loadRun4(const double* p, __m256d& x,
-                                                                 __m256d& y, __m256d& z) {
-    const __m256d a = _mm256_loadu_pd(p), b = _mm256_loadu_pd(p + 4), c = _mm256_loadu_pd(p + 8);
-    // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+/// Four particles' x y z (a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3) as three lanes.
+[[gnu::always_inline, gnu::target("avx2")]] inline void splitRun4(__m256d a, __m256d b, __m256d c,
+                                                                  __m256d& x, __m256d& y,
+                                                                  __m256d& z) {
     x = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0100), c, 0b0010),
                               _MM_SHUFFLE(1, 2, 3, 0));
     y = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b1001), c, 0b0100),
                               _MM_SHUFFLE(2, 3, 0, 1));
     z = _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0b0010), c, 0b1001),
                               _MM_SHUFFLE(3, 0, 1, 2));
+}
+
+[[gnu::always_inline, gnu::target("avx2")]] inline void loadRun4(const double* p, __m256d& x,
+                                                                 __m256d& y, __m256d& z) {
+    splitRun4(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4), _mm256_loadu_pd(p + 8), x, y, z);
 }
 
 }  // namespace rend::sim

@@ -112,29 +112,28 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 // instructions (scripts/bench_instructions.sh); the lanes below the floor are gathered in a
 // vector and asked once.
 template <bool kOne, bool kFloor>
-[[gnu::target("avx2")]] int kickQuadsAvx2(const KickDrift& input, int begin, int end,
-                                          bool& belowFloor) {
-    const KickDrift k = input;
-    bool below = false;
-    const __m256d h = _mm256_set1_pd(k.h), dt = _mm256_set1_pd(k.dt);
-    const __m256d damping = _mm256_set1_pd(k.damping), floor = _mm256_set1_pd(k.floor);
-    const double* g = k.gravity;
-    const __m256d gravity[3] = {_mm256_setr_pd(g[0], g[1], g[2], g[0]),
-                                _mm256_setr_pd(g[1], g[2], g[0], g[1]),
-                                _mm256_setr_pd(g[2], g[0], g[1], g[2])};
-    // Where the z's sit in each lane.
-    const __m256d zLanes[3] = {_mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0)),
-                               _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0)),
-                               _mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, -1))};
-    __m256d belowLanes = _mm256_setzero_pd();
-    // One mass for the sheet: one broadcast, the mass array unread (kickDriftAvx512's).
-    const __m256d oneMass = _mm256_set1_pd(k.oneMass);
-    int i = begin;
-    for (; i + 4 <= end; i += 4) {
-        if (!allFree(k.constraint + i, 4)) {
-            for (int p = i; p < i + 4; ++p) below |= kickDriftOne(k, p);
-            continue;
-        }
+struct KickQuadsAvx2 {
+    const KickDrift k;  // its own copy (above)
+    __m256d h, dt, damping, floor, oneMass, gravity[3], zLanes[3];
+    __m256d belowLanes;
+
+    [[gnu::target("avx2")]] explicit KickQuadsAvx2(const KickDrift& input) : k(input) {
+        h = _mm256_set1_pd(k.h), dt = _mm256_set1_pd(k.dt);
+        damping = _mm256_set1_pd(k.damping), floor = _mm256_set1_pd(k.floor);
+        const double* g = k.gravity;
+        gravity[0] = _mm256_setr_pd(g[0], g[1], g[2], g[0]);
+        gravity[1] = _mm256_setr_pd(g[1], g[2], g[0], g[1]);
+        gravity[2] = _mm256_setr_pd(g[2], g[0], g[1], g[2]);
+        // Where the z's sit in each lane.
+        zLanes[0] = _mm256_castsi256_pd(_mm256_setr_epi64x(0, 0, -1, 0));
+        zLanes[1] = _mm256_castsi256_pd(_mm256_setr_epi64x(0, -1, 0, 0));
+        zLanes[2] = _mm256_castsi256_pd(_mm256_setr_epi64x(-1, 0, 0, -1));
+        belowLanes = _mm256_setzero_pd();
+        // One mass for the sheet: one broadcast, the mass array unread (kickDriftAvx512's).
+        oneMass = _mm256_set1_pd(k.oneMass);
+    }
+    /// Free particles i to i + 3 kicked and drifted; their new velocities in `vel`'s lanes.
+    [[gnu::always_inline, gnu::target("avx2")]] void free(int i, __m256d (&vel)[3]) {
         __m256d mass[3] = {oneMass, oneMass, oneMass};
         if constexpr (!kOne) {
             const double* m = k.mass + i;
@@ -146,21 +145,39 @@ template <bool kOne, bool kFloor>
             double* v = k.v + 3 * i + 4 * lane;
             double* x = k.x + 3 * i + 4 * lane;
             const __m256d f = _mm256_loadu_pd(k.forceOf(i) + 4 * lane);
-            __m256d vel = _mm256_loadu_pd(v);
+            __m256d u = _mm256_loadu_pd(v);
             const __m256d acceleration =
                 _mm256_sub_pd(_mm256_add_pd(_mm256_div_pd(f, mass[lane]), gravity[lane]),
-                              _mm256_mul_pd(damping, vel));
-            vel = _mm256_add_pd(vel, _mm256_mul_pd(h, acceleration));
-            _mm256_storeu_pd(v, vel);
-            const __m256d to = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_mul_pd(dt, vel));
+                              _mm256_mul_pd(damping, u));
+            u = _mm256_add_pd(u, _mm256_mul_pd(h, acceleration));
+            _mm256_storeu_pd(v, u);
+            const __m256d to = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_mul_pd(dt, u));
             _mm256_storeu_pd(x, to);
             if constexpr (kFloor)
                 belowLanes = _mm256_or_pd(
                     belowLanes, _mm256_and_pd(_mm256_cmp_pd(to, floor, _CMP_NGE_UQ), zLanes[lane]));
+            vel[lane] = u;
         }
     }
-    below = below || _mm256_movemask_pd(belowLanes) != 0;
-    belowFloor = belowFloor || below;
+    /// Whether a lane ended below the floor.
+    [[gnu::target("avx2")]] bool below() const { return _mm256_movemask_pd(belowLanes) != 0; }
+};
+
+template <bool kOne, bool kFloor>
+[[gnu::target("avx2")]] int kickQuadsAvx2(const KickDrift& input, int begin, int end,
+                                          bool& belowFloor) {
+    KickQuadsAvx2<kOne, kFloor> kick(input);
+    bool below = false;
+    int i = begin;
+    for (; i + 4 <= end; i += 4) {
+        if (!allFree(kick.k.constraint + i, 4)) {
+            for (int p = i; p < i + 4; ++p) below |= kickDriftOne(kick.k, p);
+            continue;
+        }
+        __m256d vel[3];
+        kick.free(i, vel);
+    }
+    belowFloor = belowFloor || below || kick.below();
     return i;
 }
 
@@ -228,35 +245,30 @@ int kickDriftAvx2(const KickDrift& k, int begin, int end, bool& belowFloor) {
 // constants of the loop, and the lanes' indices a vector that moves on by four: a branch on
 // each, and the index converted and broadcast, were 10 of a quad's 58 instructions
 // (scripts/bench_instructions.sh).
+/// The four chains of guardQuadsAvx2, a quad at a time from `begin`: a free quad's velocities in
+/// lanes (free()), a quad with a particle that is not free one by one (notFree()), the tail and
+/// the totals (finish()).
 template <bool kOne, bool kGravity>
-[[gnu::target("avx2")]] GuardSums guardQuadsAvx2(const GuardInput& g, int begin, int end) {
+struct GuardQuadsAvx2 {
+    const GuardInput& g;
     GuardSums s;
-    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(g.limitSquared);
-    const __m256d gx = _mm256_set1_pd(g.gravity[0]), gy = _mm256_set1_pd(g.gravity[1]);
-    const __m256d gz = _mm256_set1_pd(g.gravity[2]), sign = _mm256_set1_pd(-0.0);
-    const __m256d four = _mm256_set1_pd(4.0);
-    __m256d kinetic = _mm256_setzero_pd(), gravityPower = _mm256_setzero_pd();
-    __m256d best = _mm256_setzero_pd(), bestAt = _mm256_set1_pd(-1.0);  // indices, exact
     GuardPart p[4];
-    const __m256d oneMass = _mm256_set1_pd(g.oneMass);
-    const __m256d halfOneMass = _mm256_mul_pd(half, oneMass);
-    int i = begin;
-    __m256d at = _mm256_add_pd(_mm256_set1_pd(double(i)), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
-    for (; i + 4 <= end; i += 4, at = _mm256_add_pd(at, four)) {
-        if (!allFree(g.constraint + i, 4)) {
-            double k[4], w[4];
-            _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
-            for (int l = 0; l < 4; ++l) {
-                p[l].kinetic = k[l], p[l].gravityPower = w[l];
-                guardVisit(g, i + l, p[l], s);
-            }
-            kinetic = _mm256_setr_pd(p[0].kinetic, p[1].kinetic, p[2].kinetic, p[3].kinetic);
-            gravityPower = _mm256_setr_pd(p[0].gravityPower, p[1].gravityPower, p[2].gravityPower,
-                                          p[3].gravityPower);
-            continue;
-        }
-        __m256d vx, vy, vz;
-        loadRun4(g.v + 3 * std::size_t(i), vx, vy, vz);
+    __m256d half, limit, gx, gy, gz, sign, four, oneMass, halfOneMass;
+    __m256d kinetic, gravityPower, best, bestAt, at;  // bestAt, at: indices, exact
+
+    [[gnu::target("avx2")]] GuardQuadsAvx2(const GuardInput& input, int begin) : g(input) {
+        half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(g.limitSquared);
+        gx = _mm256_set1_pd(g.gravity[0]), gy = _mm256_set1_pd(g.gravity[1]);
+        gz = _mm256_set1_pd(g.gravity[2]), sign = _mm256_set1_pd(-0.0);
+        four = _mm256_set1_pd(4.0), oneMass = _mm256_set1_pd(g.oneMass);
+        halfOneMass = _mm256_mul_pd(half, oneMass);
+        kinetic = gravityPower = best = _mm256_setzero_pd();
+        bestAt = _mm256_set1_pd(-1.0);
+        at = _mm256_add_pd(_mm256_set1_pd(double(begin)), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
+    }
+    /// Particles i to i + 3, whose lanes are `at` (then moved on by four).
+    [[gnu::always_inline, gnu::target("avx2")]] void free(__m256d vx, __m256d vy, __m256d vz,
+                                                          int i) {
         const __m256d ss = _mm256_add_pd(
             _mm256_add_pd(_mm256_mul_pd(vx, vx), _mm256_mul_pd(vy, vy)), _mm256_mul_pd(vz, vz));
         const int bad = _mm256_movemask_pd(_mm256_cmp_pd(ss, limit, _CMP_NLE_UQ));
@@ -273,25 +285,99 @@ template <bool kOne, bool kGravity>
         const __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
         best = _mm256_blendv_pd(best, ss, faster);
         bestAt = _mm256_blendv_pd(bestAt, at, faster);
+        at = _mm256_add_pd(at, four);
     }
-    double k[4], w[4], speeds[4], lanes[4];
-    _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
-    _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(lanes, bestAt);
-    for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
-    for (; i < end; ++i) guardVisit(g, i, p[0], s);
-    const auto total = [&](double GuardPart::*field) {
-        return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
-    };
-    s.kinetic = total(&GuardPart::kinetic);
-    s.boundaryPower = total(&GuardPart::boundaryPower);
-    s.gravityPower = total(&GuardPart::gravityPower);
-    for (int l = 0; l < 4; ++l) {
-        const bool higher = speeds[l] > s.maxSpeedSquared;
-        const bool tie = speeds[l] == s.maxSpeedSquared && int(lanes[l]) < s.fastest;
-        if (lanes[l] >= 0.0 && (higher || tie))
-            s.maxSpeedSquared = speeds[l], s.fastest = int(lanes[l]);
+    /// Particles i to i + 3 one by one, into the same chains.
+    [[gnu::target("avx2")]] void notFree(int i) {
+        double k[4], w[4];
+        _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
+        for (int l = 0; l < 4; ++l) {
+            p[l].kinetic = k[l], p[l].gravityPower = w[l];
+            guardVisit(g, i + l, p[l], s);
+        }
+        kinetic = _mm256_setr_pd(p[0].kinetic, p[1].kinetic, p[2].kinetic, p[3].kinetic);
+        gravityPower = _mm256_setr_pd(p[0].gravityPower, p[1].gravityPower, p[2].gravityPower,
+                                      p[3].gravityPower);
+        at = _mm256_add_pd(at, four);
     }
-    return s;
+    /// Particles [i, end) one by one into chain 0, then the chains' totals.
+    [[gnu::target("avx2")]] GuardSums finish(int i, int end) {
+        double k[4], w[4], speeds[4], lanes[4];
+        _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
+        _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(lanes, bestAt);
+        for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
+        for (; i < end; ++i) guardVisit(g, i, p[0], s);
+        const auto total = [&](double GuardPart::*field) {
+            return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
+        };
+        s.kinetic = total(&GuardPart::kinetic);
+        s.boundaryPower = total(&GuardPart::boundaryPower);
+        s.gravityPower = total(&GuardPart::gravityPower);
+        for (int l = 0; l < 4; ++l) {
+            const bool higher = speeds[l] > s.maxSpeedSquared;
+            const bool tie = speeds[l] == s.maxSpeedSquared && int(lanes[l]) < s.fastest;
+            if (lanes[l] >= 0.0 && (higher || tie))
+                s.maxSpeedSquared = speeds[l], s.fastest = int(lanes[l]);
+        }
+        return s;
+    }
+};
+
+template <bool kOne, bool kGravity>
+[[gnu::target("avx2")]] GuardSums guardQuadsAvx2(const GuardInput& g, int begin, int end) {
+    GuardQuadsAvx2<kOne, kGravity> chains(g, begin);
+    int i = begin;
+    for (; i + 4 <= end; i += 4) {
+        if (!allFree(g.constraint + i, 4)) {
+            chains.notFree(i);
+            continue;
+        }
+        __m256d vx, vy, vz;
+        loadRun4(g.v + 3 * std::size_t(i), vx, vy, vz);
+        chains.free(vx, vy, vz, i);
+    }
+    return chains.finish(i, end);
+}
+
+// The kick and drift of a block and the blow-up guard's sums of it in one loop (kickDriftSampled):
+// each free quad's new velocities split into lanes from the registers the kick stored them from,
+// not loaded again; the kick's and the guard's quads from the same `begin`, so the same chains.
+template <bool kOne, bool kFloor, bool kGravity>
+[[gnu::target("avx2")]] GuardSums kickGuardQuadsAvx2(const KickDrift& input, const GuardInput& g,
+                                                     int begin, int end, bool& belowFloor) {
+    KickQuadsAvx2<kOne, kFloor> kick(input);
+    GuardQuadsAvx2<kOne, kGravity> chains(g, begin);
+    bool below = false;
+    int i = begin;
+    for (; i + 4 <= end; i += 4) {
+        if (!allFree(kick.k.constraint + i, 4)) {
+            for (int p = i; p < i + 4; ++p) below |= kickDriftOne(kick.k, p);
+            chains.notFree(i);
+            continue;
+        }
+        __m256d vel[3], vx, vy, vz;
+        kick.free(i, vel);
+        splitRun4(vel[0], vel[1], vel[2], vx, vy, vz);
+        chains.free(vx, vy, vz, i);
+    }
+    for (int p = i; p < end; ++p) below |= kickDriftOne(kick.k, p);
+    belowFloor = belowFloor || below || kick.below();
+    return chains.finish(i, end);
+}
+
+template <bool kOne, bool kFloor>
+GuardSums kickGuardGravityAvx2(const KickDrift& k, const GuardInput& g, int begin, int end,
+                               bool& below) {
+    return g.hasGravity ? kickGuardQuadsAvx2<kOne, kFloor, true>(k, g, begin, end, below)
+                        : kickGuardQuadsAvx2<kOne, kFloor, false>(k, g, begin, end, below);
+}
+
+template <bool kOne>
+GuardSums kickGuardFloorAvx2(const KickDrift& k, const GuardInput& g, int begin, int end,
+                             bool& below) {
+    return k.floor != -std::numeric_limits<double>::infinity()
+               ? kickGuardGravityAvx2<kOne, true>(k, g, begin, end, below)
+               : kickGuardGravityAvx2<kOne, false>(k, g, begin, end, below);
 }
 
 GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
@@ -469,6 +555,22 @@ bool kickDrift(const KickDrift& k, int begin, int end) {
     for (int i = begin; i < end; ++i) below |= kickDriftOne(k, i);
     // No floor (-inf): nothing is below it, whatever its height (the four-lane loop does not ask).
     return below && k.floor != -std::numeric_limits<double>::infinity();
+}
+
+GuardSums kickDriftSampled(const KickDrift& k, const GuardInput& g, int begin, int end,
+                           bool& below) {
+#if defined(__x86_64__)
+    // One loop where both have four lanes, read the same velocities and agree on one mass.
+    if (simdWidth() == 4 && g.v == k.v && g.oneMass == k.oneMass) {
+        bool under = false;
+        const GuardSums s = k.oneMass > 0.0 ? kickGuardFloorAvx2<true>(k, g, begin, end, under)
+                                            : kickGuardFloorAvx2<false>(k, g, begin, end, under);
+        below = under && k.floor != -std::numeric_limits<double>::infinity();
+        return s;
+    }
+#endif
+    below = kickDrift(k, begin, end);
+    return guardMotionSums(g, begin, end);
 }
 
 }  // namespace rend::sim

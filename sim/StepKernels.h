@@ -75,6 +75,11 @@ GuardSums guardSums(const GuardInput& g, int begin, int end);
 GuardSums guardMotionSums(const GuardInput& g, int begin, int end);
 GuardSums guardThetaSums(const double* theta, int begin, int end);
 void addThetaSums(GuardSums& motion, const GuardSums& theta);
+/// kickDrift over [begin, end) (`below` its answer), and guardMotionSums(g, begin, end) of the
+/// velocities it leaves: the same bits as the two one after the other, in one pass where both
+/// run four lanes wide. g.v must be k.v.
+GuardSums kickDriftSampled(const KickDrift& k, const GuardInput& g, int begin, int end,
+                           bool& below);
 
 /// Lanes of the vector kernels here and in sim/PairKernels.h: 8 with AVX-512, 4 with AVX2, 1
 /// without. REND_SIMD=avx2 or REND_SIMD=scalar in the environment caps it (to compare them; every

@@ -311,3 +311,70 @@ TEST(GuardSums, OneMassGivesTheSumsOfEveryParticleHavingIt) {
 }
 
 }  // namespace
+
+namespace {
+
+bool sameSums(const GuardSums& a, const GuardSums& b) {
+    return std::memcmp(&a.kinetic, &b.kinetic, sizeof(double)) == 0 &&
+           std::memcmp(&a.boundaryPower, &b.boundaryPower, sizeof(double)) == 0 &&
+           std::memcmp(&a.gravityPower, &b.gravityPower, sizeof(double)) == 0 &&
+           a.maxSpeedSquared == b.maxSpeedSquared && a.fastest == b.fastest &&
+           a.firstBad == b.firstBad && a.maxAbsTheta == b.maxAbsTheta;
+}
+
+// The kick with the guard's sums in its loop (kickDriftSampled, adaptive steps' blocks): the
+// bits of kickDrift and then guardMotionSums, at every width, from starts that are not multiples
+// of four, with pinned and driven particles, with and without one mass, gravity and a floor, and
+// with a particle past the speed limit.
+TEST(KickDrift, SampledGivesTheBitsOfTheKickAndThenTheGuard) {
+    const std::vector<double> boundary = {0.5, 0.0, -0.25, 0.0, 1e-3, 2.0};
+    int cases = 0;
+    for (const bool one : {false, true})
+        for (const bool gravity : {false, true})
+            for (const bool floor : {false, true})
+                for (const bool fast : {false, true}) {
+                    Particles start = someParticles(203);
+                    if (one) start.mass.assign(start.mass.size(), 3.7e-4);
+                    if (fast) start.v[150] = Eigen::Vector3d(0.0, 1e20, 0.0);  // past the limit
+                    for (const auto& [first, end] : {std::pair{0, 203}, {3, 101}, {101, 203}}) {
+                        Particles a = start, b = start;
+                        const auto setUp = [&](Particles& p) {
+                            KickDrift k = viewOf(p, boundary, 1.3e-4, 1.1e-4);
+                            k.damping = 0.7, k.oneMass = one ? 3.7e-4 : 0.0;
+                            if (gravity) k.gravity[0] = 0.3, k.gravity[2] = -9.81;
+                            if (floor) k.floor = 0.2;
+                            return k;
+                        };
+                        const auto guardOf = [&](Particles& p, const KickDrift& k) {
+                            GuardInput g{p.v.data()->data(),
+                                         p.force.data()->data(),
+                                         p.mass.data(),
+                                         p.constraint.data(),
+                                         nullptr,
+                                         1e30,
+                                         {},
+                                         gravity};
+                            for (int c = 0; c < 3; ++c) g.gravity[c] = k.gravity[c];
+                            g.oneMass = k.oneMass;
+                            return g;
+                        };
+                        const KickDrift ka = setUp(a), kb = setUp(b);
+                        const bool belowA = kickDrift(ka, first, end);
+                        const GuardSums want = guardMotionSums(guardOf(a, ka), first, end);
+                        bool belowB = !belowA;
+                        const GuardSums got =
+                            kickDriftSampled(kb, guardOf(b, kb), first, end, belowB);
+                        EXPECT_TRUE(sameBits(b.v, a.v)) << one << gravity << floor << first;
+                        EXPECT_TRUE(sameBits(b.x, a.x)) << one << gravity << floor << first;
+                        EXPECT_EQ(belowB, belowA) << one << gravity << floor << first;
+                        EXPECT_TRUE(sameSums(got, want)) << one << gravity << floor << first;
+                        EXPECT_GT(got.kinetic, 0.0);
+                        const bool bad = fast && first <= 150 && end > 150;
+                        EXPECT_EQ(got.firstBad, bad ? 150 : -1) << one << gravity << floor;
+                        ++cases;
+                    }
+                }
+    EXPECT_EQ(cases, 48);
+}
+
+}  // namespace

@@ -84,6 +84,16 @@ GuardSums guardThetaScalar(const double* theta, int begin, int end) {
     return s;
 }
 
+/// The four chains' sums into s, added (0 + 1) + (2 + 3).
+inline void addChains(const GuardPart (&p)[4], GuardSums& s) {
+    const auto total = [&](double GuardPart::*field) {
+        return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
+    };
+    s.kinetic = total(&GuardPart::kinetic);
+    s.boundaryPower = total(&GuardPart::boundaryPower);
+    s.gravityPower = total(&GuardPart::gravityPower);
+}
+
 /// Four chains, of every fourth particle, added in a fixed order.
 GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     GuardSums s;
@@ -92,12 +102,7 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
     for (; i + 4 <= end; i += 4)
         for (int k = 0; k < 4; ++k) guardVisit(g, i + k, p[k], s);
     for (; i < end; ++i) guardVisit(g, i, p[0], s);
-    const auto total = [&](double GuardPart::*field) {
-        return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
-    };
-    s.kinetic = total(&GuardPart::kinetic);
-    s.boundaryPower = total(&GuardPart::boundaryPower);
-    s.gravityPower = total(&GuardPart::gravityPower);
+    addChains(p, s);
     return s;
 }
 
@@ -307,12 +312,7 @@ struct GuardQuadsAvx2 {
         _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(lanes, bestAt);
         for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
         for (; i < end; ++i) guardVisit(g, i, p[0], s);
-        const auto total = [&](double GuardPart::*field) {
-            return (p[0].*field + p[1].*field) + (p[2].*field + p[3].*field);
-        };
-        s.kinetic = total(&GuardPart::kinetic);
-        s.boundaryPower = total(&GuardPart::boundaryPower);
-        s.gravityPower = total(&GuardPart::gravityPower);
+        addChains(p, s);
         for (int l = 0; l < 4; ++l) {
             const bool higher = speeds[l] > s.maxSpeedSquared;
             const bool tie = speeds[l] == s.maxSpeedSquared && int(lanes[l]) < s.fastest;

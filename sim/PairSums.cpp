@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sim/PairKernels.h"
+#include "sim/SimdRuns.h"
 #include "sim/StepKernels.h"
 
 namespace rend::sim {
@@ -461,17 +462,6 @@ template <int kBonds, bool kRegular>
 // crack_path_sources at 10^4, linear law, the sums' cpu-clock samples fell from 0.38 of the pair
 // kernel's to 0.26; with the blow-up guard's AVX2 loop, alternate runs 32.4 -> 28.2 and 34.2 ->
 // 28.9 ns per particle-step, stretch 26.4 -> 20.5 and 25.1 -> 22.3.
-
-/// Four particles' x y z from their lanes (loadRun4's inverse): three stores.
-[[gnu::target("avx2")]] inline void storeRun4(double* out, __m256d x, __m256d y, __m256d z) {
-    // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
-    const __m256d xs = _mm256_permute4x64_pd(x, _MM_SHUFFLE(1, 2, 3, 0));  // x0 x3 x2 x1
-    const __m256d ys = _mm256_permute_pd(y, 0b0101);                       // y1 y0 y3 y2
-    const __m256d zs = _mm256_permute4x64_pd(z, _MM_SHUFFLE(3, 0, 1, 2));  // z2 z1 z0 z3
-    _mm256_storeu_pd(out, _mm256_blend_pd(_mm256_blend_pd(xs, ys, 0b0010), zs, 0b0100));
-    _mm256_storeu_pd(out + 4, _mm256_blend_pd(_mm256_blend_pd(ys, zs, 0b0010), xs, 0b0100));
-    _mm256_storeu_pd(out + 8, _mm256_blend_pd(_mm256_blend_pd(zs, xs, 0b0010), ys, 0b0100));
-}
 
 /// Bit k: life flag k of the 32 from `alive` is zero.
 [[gnu::target("avx2")]] inline unsigned deadOf32(const std::uint8_t* alive) {

@@ -81,6 +81,8 @@ public:
     void check(const State& state, const std::function<double()>& totalEnergy);
 
     double budget() const { return budget_; }
+    /// The free particles' kinetic energy at the last check (over every process) [J].
+    double checkedKinetic() const { return lastKinetic_; }
     /// The largest free particle's |v|^2 at the last check (over every process), or < 0 before
     /// the first.
     double checkedSpeedSquared() const { return checkedSpeedSquared_; }
@@ -99,7 +101,9 @@ public:
     Sample sample(const State& state) const;
 
     /// Particles per block of a sample: fixed, so that its sums do not depend on the threads.
-    static constexpr int kBlock = 1024;
+    /// A solver's pass moves PeridynamicBonds::kFusedBlock particles at a time: as many, so
+    /// that the kick in the pass takes a block's sums in its own loop.
+    static constexpr int kBlock = 512;
     /// The motion half of the next check's sample (all but theta), block by block, taken by the
     /// integrator right after it moved each block, while the block is in cache: the bits
     /// check() would take. beginMotion() over the particles [first, last) a check samples,

@@ -373,14 +373,21 @@ double Membrane::stiffeningNeeded() const {
 namespace {
 
 // Membrane's kick and drift of each block the solver's pass hands over (StepState::motion), and
-// the blow-up guard's sample of each of the guard's blocks once all of it has moved, by the
-// thread that moved its last particles: the separate pass's kernels and sums over the same
-// blocks, so the same bits.
+// the blow-up guard's sample of each of the guard's blocks: in the kick's own loop where the
+// pass hands over the whole block (kickDriftSampled, as kickAndDrift), else once all of it has
+// moved, by the thread that moved its last particles. The separate pass's kernels and sums over
+// the same blocks, so the same bits.
 class KickInPass final : public BlockMotion {
 public:
     KickInPass(const KickDrift& kick, double* forceArray, BlowUpGuard& guard,
                const BlowUpGuard::State& state, int first, int last)
-        : kick_(kick), forceArray_(forceArray), guard_(guard), state_(state), first_(first) {
+        : kick_(kick),
+          forceArray_(forceArray),
+          guard_(guard),
+          state_(state),
+          sample_(guard.motionInput(state)),
+          first_(first),
+          last_(last) {
         constexpr int kBlock = BlowUpGuard::kBlock;
         const int blocks = (last - first + kBlock - 1) / kBlock;
         left_ = std::make_unique<std::atomic<int>[]>(std::size_t(blocks));
@@ -391,15 +398,25 @@ public:
     void move(int begin, int end, const double* block, int first) override {
         KickDrift k = kick_;
         if (block) k.force = block, k.forceFirst = first, k.keptForce = forceArray_;
-        if (kickDrift(k, begin, end)) below_.store(true, std::memory_order_relaxed);
-        moved_.fetch_add(end - begin, std::memory_order_relaxed);
+        bool below = false;
         constexpr int kBlock = BlowUpGuard::kBlock;
-        for (int b = (begin - first_) / kBlock; first_ + b * kBlock < end; ++b) {
-            const int part =
-                std::min(end, first_ + (b + 1) * kBlock) - std::max(begin, first_ + b * kBlock);
-            if (left_[b].fetch_sub(part, std::memory_order_acq_rel) == part)
-                guard_.sampleMotion(state_, b);
+        for (int i = begin; i < end;) {
+            const int b = (i - first_) / kBlock, blockBegin = first_ + b * kBlock;
+            const int blockEnd = std::min(last_, blockBegin + kBlock),
+                      stop = std::min(end, blockEnd);
+            if (i == blockBegin && stop == blockEnd) {
+                bool under = false;
+                guard_.recordMotion(b, kickDriftSampled(k, sample_, i, stop, under));
+                below = below || under;
+            } else {
+                below = kickDrift(k, i, stop) || below;
+                if (left_[b].fetch_sub(stop - i, std::memory_order_acq_rel) == stop - i)
+                    guard_.sampleMotion(state_, b);
+            }
+            i = stop;
         }
+        if (below) below_.store(true, std::memory_order_relaxed);
+        moved_.fetch_add(end - begin, std::memory_order_relaxed);
     }
     int moved() const { return moved_.load(); }
     /// kickAndDrift's answer: whether a free particle may touch the ground.
@@ -410,7 +427,8 @@ private:
     double* forceArray_;
     BlowUpGuard& guard_;
     BlowUpGuard::State state_;
-    int first_;
+    GuardInput sample_;
+    int first_, last_;
     std::unique_ptr<std::atomic<int>[]> left_;
     std::atomic<int> moved_{0};
     std::atomic<bool> below_{false};

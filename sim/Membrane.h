@@ -107,6 +107,8 @@ public:
     /// The blow-up guard's energy budget so far [J]: the start's energy and the work the
     /// boundaries (|force . v| on the driven particles), gravity and the rest did since.
     double energyBudget() const { return guard_.budget(); }
+    /// The free particles' kinetic energy the blow-up guard measured at its last check [J].
+    double checkedKinetic() const { return guard_.checkedKinetic(); }
 
     /// Adaptive stepping (time.dt = "adaptive", sim/TimeStep.h): steps until time() is exactly
     /// tEnd, each step from the controller, the last ones evened out to land on tEnd.

@@ -51,7 +51,8 @@ struct Steps {
     std::vector<std::uint8_t> alive;
     bool keptInPass = true;  ///< every step's
     std::size_t broken = 0;
-    double budget = 0.0;  ///< the blow-up guard's: the driven particles' forces times velocities
+    double budget = 0.0;   ///< the blow-up guard's: the driven particles' forces times velocities
+    double kinetic = 0.0;  ///< the blow-up guard's sum over the free particles
 };
 
 Steps stepped(const MembraneParams& p, bool inPass, int threads, int steps) {
@@ -67,6 +68,7 @@ Steps stepped(const MembraneParams& p, bool inPass, int threads, int steps) {
     r.alive = m.damageState().bondAlive();
     r.broken = m.damageState().brokenBondCount();
     r.budget = m.energyBudget();
+    r.kinetic = m.checkedKinetic();
     return r;
 }
 
@@ -82,6 +84,8 @@ void expectSameBits(const Steps& a, const Steps& b, const std::string& what) {
     EXPECT_TRUE(sameBits(a.alive, b.alive)) << what << ": bonds";
     EXPECT_EQ(std::memcmp(&a.budget, &b.budget, sizeof a.budget), 0)
         << what << ": the guard's budget " << a.budget << " against " << b.budget;
+    EXPECT_EQ(std::memcmp(&a.kinetic, &b.kinetic, sizeof a.kinetic), 0)
+        << what << ": the guard's kinetic energy " << a.kinetic << " against " << b.kinetic;
 }
 
 }  // namespace

@@ -115,7 +115,9 @@ GuardSums guardScalar(const GuardInput& g, int begin, int end) {
 // loop's). One mass for the sheet (kOne) and a floor (kFloor) are constants of the loop: a
 // branch on the one, and the other's test where there is no floor, were 12 of a quad's 76
 // instructions (scripts/bench_instructions.sh); the lanes below the floor are gathered in a
-// vector and asked once.
+// vector and asked once. A quad with a pinned or driven particle (mixed()) is kicked as if free
+// and theirs then take their prescribed velocities from a blend: one at a time, such a quad was
+// about 490 instructions (stretch's grips: a third of the kick's count).
 template <bool kOne, bool kFloor>
 struct KickQuadsAvx2 {
     const KickDrift k;  // its own copy (above)
@@ -139,6 +141,37 @@ struct KickQuadsAvx2 {
     }
     /// Free particles i to i + 3 kicked and drifted; their new velocities in `vel`'s lanes.
     [[gnu::always_inline, gnu::target("avx2")]] void free(int i, __m256d (&vel)[3]) {
+        quad<false>(i, vel);
+    }
+    /// Particles i to i + 3, some pinned or driven: kickDriftOne's bits in every lane.
+    [[gnu::always_inline, gnu::target("avx2")]] void mixed(int i, __m256d (&vel)[3]) {
+        quad<true>(i, vel);
+    }
+    /// Lanes of the particles i to i + 3 that are not free (all bits set), and their
+    /// velocities (pinned: 0); their forces copied where a block kept them (KickDrift::keptForce).
+    [[gnu::always_inline, gnu::target("avx2")]] void prescribedOf(int i, __m256d (&held)[3],
+                                                                  __m256d (&prescribed)[3]) const {
+        alignas(32) double velocity[12];
+        alignas(32) std::int64_t tag[12];
+        for (int p = 0; p < 4; ++p) {
+            const std::int16_t c = k.constraint[i + p];
+            for (int a = 0; a < 3; ++a) {
+                velocity[3 * p + a] = c >= 0 ? k.boundaryVelocity[3 * c + a] : 0.0;
+                tag[3 * p + a] = c == kFree ? 0 : -1;
+            }
+            if (c != kFree && k.keptForce)
+                for (int a = 0; a < 3; ++a) k.keptForce[3 * (i + p) + a] = k.forceOf(i + p)[a];
+        }
+        for (int lane = 0; lane < 3; ++lane) {
+            prescribed[lane] = _mm256_load_pd(velocity + 4 * lane);
+            held[lane] = _mm256_castsi256_pd(
+                _mm256_load_si256(reinterpret_cast<const __m256i*>(tag + 4 * lane)));
+        }
+    }
+    template <bool kMixed>
+    [[gnu::always_inline, gnu::target("avx2")]] void quad(int i, __m256d (&vel)[3]) {
+        __m256d held[3], prescribed[3];
+        if constexpr (kMixed) prescribedOf(i, held, prescribed);
         __m256d mass[3] = {oneMass, oneMass, oneMass};
         if constexpr (!kOne) {
             const double* m = k.mass + i;
@@ -155,12 +188,16 @@ struct KickQuadsAvx2 {
                 _mm256_sub_pd(_mm256_add_pd(_mm256_div_pd(f, mass[lane]), gravity[lane]),
                               _mm256_mul_pd(damping, u));
             u = _mm256_add_pd(u, _mm256_mul_pd(h, acceleration));
+            if constexpr (kMixed) u = _mm256_blendv_pd(u, prescribed[lane], held[lane]);
             _mm256_storeu_pd(v, u);
             const __m256d to = _mm256_add_pd(_mm256_loadu_pd(x), _mm256_mul_pd(dt, u));
             _mm256_storeu_pd(x, to);
-            if constexpr (kFloor)
-                belowLanes = _mm256_or_pd(
-                    belowLanes, _mm256_and_pd(_mm256_cmp_pd(to, floor, _CMP_NGE_UQ), zLanes[lane]));
+            if constexpr (kFloor) {
+                const __m256d z =
+                    kMixed ? _mm256_andnot_pd(held[lane], zLanes[lane]) : zLanes[lane];
+                belowLanes = _mm256_or_pd(belowLanes,
+                                          _mm256_and_pd(_mm256_cmp_pd(to, floor, _CMP_NGE_UQ), z));
+            }
             vel[lane] = u;
         }
     }
@@ -172,17 +209,15 @@ template <bool kOne, bool kFloor>
 [[gnu::target("avx2")]] int kickQuadsAvx2(const KickDrift& input, int begin, int end,
                                           bool& belowFloor) {
     KickQuadsAvx2<kOne, kFloor> kick(input);
-    bool below = false;
     int i = begin;
     for (; i + 4 <= end; i += 4) {
-        if (!allFree(kick.k.constraint + i, 4)) {
-            for (int p = i; p < i + 4; ++p) below |= kickDriftOne(kick.k, p);
-            continue;
-        }
         __m256d vel[3];
-        kick.free(i, vel);
+        if (allFree(kick.k.constraint + i, 4))
+            kick.free(i, vel);
+        else
+            kick.mixed(i, vel);
     }
-    belowFloor = belowFloor || below || kick.below();
+    belowFloor = belowFloor || kick.below();
     return i;
 }
 
@@ -244,22 +279,22 @@ int kickDriftAvx2(const KickDrift& k, int begin, int end, bool& belowFloor) {
 }
 
 // Four particles at a time, lane k the scalar loop's chain k (guardScalar's): the same bits.
-// A quad with a particle that is not free is visited one by one into the same chains. The
+// A quad with a particle that is not free takes each lane's terms by its tag, from blends. The
 // scalar loop had 0.12 of a step's cpu-clock samples on one Zen 3 core (crack_path_sources at
 // 10^4, linear law), this one 0.05. One mass for the sheet (kOne) and gravity (kGravity) are
 // constants of the loop, and the lanes' indices a vector that moves on by four: a branch on
 // each, and the index converted and broadcast, were 10 of a quad's 58 instructions
 // (scripts/bench_instructions.sh).
 /// The four chains of guardQuadsAvx2, a quad at a time from `begin`: a free quad's velocities in
-/// lanes (free()), a quad with a particle that is not free one by one (notFree()), the tail and
-/// the totals (finish()).
+/// lanes (free()), a quad with a particle that is not free (mixed()), the tail and the totals
+/// (finish()).
 template <bool kOne, bool kGravity>
 struct GuardQuadsAvx2 {
     const GuardInput& g;
     GuardSums s;
     GuardPart p[4];
     __m256d half, limit, gx, gy, gz, sign, four, oneMass, halfOneMass;
-    __m256d kinetic, gravityPower, best, bestAt, at;  // bestAt, at: indices, exact
+    __m256d kinetic, gravityPower, boundaryPower, best, bestAt, at;  // bestAt, at: exact indices
 
     [[gnu::target("avx2")]] GuardQuadsAvx2(const GuardInput& input, int begin) : g(input) {
         half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(g.limitSquared);
@@ -267,50 +302,71 @@ struct GuardQuadsAvx2 {
         gz = _mm256_set1_pd(g.gravity[2]), sign = _mm256_set1_pd(-0.0);
         four = _mm256_set1_pd(4.0), oneMass = _mm256_set1_pd(g.oneMass);
         halfOneMass = _mm256_mul_pd(half, oneMass);
-        kinetic = gravityPower = best = _mm256_setzero_pd();
+        kinetic = gravityPower = boundaryPower = best = _mm256_setzero_pd();
         bestAt = _mm256_set1_pd(-1.0);
         at = _mm256_add_pd(_mm256_set1_pd(double(begin)), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
     }
-    /// Particles i to i + 3, whose lanes are `at` (then moved on by four).
+    /// Free particles i to i + 3, whose lanes are `at` (then moved on by four).
     [[gnu::always_inline, gnu::target("avx2")]] void free(__m256d vx, __m256d vy, __m256d vz,
                                                           int i) {
+        visit<false>(vx, vy, vz, i, _mm256_setzero_pd());
+    }
+    /// Particles i to i + 3, some pinned or driven (guardVisit's terms by each lane's tag): the
+    /// driven add |f . v| to their chain's boundary power, the free as free().
+    [[gnu::always_inline, gnu::target("avx2")]] void mixed(__m256d vx, __m256d vy, __m256d vz,
+                                                           int i) {
+        const __m256i tags = _mm256_cvtepi16_epi64(
+            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(g.constraint + i)));
+        const __m256i freeTag = _mm256_set1_epi64x(kFree);
+        const __m256d free = _mm256_castsi256_pd(_mm256_cmpeq_epi64(tags, freeTag));
+        const __m256d driven = _mm256_castsi256_pd(_mm256_cmpgt_epi64(tags, freeTag));
+        __m256d fx, fy, fz;
+        loadRun4(g.force + 3 * std::size_t(i), fx, fy, fz);
+        const __m256d power = _mm256_andnot_pd(
+            sign, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(fx, vx), _mm256_mul_pd(fy, vy)),
+                                _mm256_mul_pd(fz, vz)));
+        boundaryPower =
+            _mm256_blendv_pd(boundaryPower, _mm256_add_pd(boundaryPower, power), driven);
+        visit<true>(vx, vy, vz, i, free);
+    }
+    /// sum + term; with kMixed only in the lanes of `free` (a blend: adding 0 to -0.0 is +0.0).
+    template <bool kMixed>
+    [[gnu::always_inline, gnu::target("avx2")]] static __m256d addWhere(__m256d sum, __m256d term,
+                                                                        __m256d free) {
+        const __m256d more = _mm256_add_pd(sum, term);
+        return kMixed ? _mm256_blendv_pd(sum, more, free) : more;
+    }
+    /// With kMixed, only the lanes of `free` are free.
+    template <bool kMixed>
+    [[gnu::always_inline, gnu::target("avx2")]] void visit(__m256d vx, __m256d vy, __m256d vz,
+                                                           int i, __m256d free) {
         const __m256d ss = _mm256_add_pd(
             _mm256_add_pd(_mm256_mul_pd(vx, vx), _mm256_mul_pd(vy, vy)), _mm256_mul_pd(vz, vz));
         const int bad = _mm256_movemask_pd(_mm256_cmp_pd(ss, limit, _CMP_NLE_UQ));
         if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(unsigned(bad));
         const __m256d m = kOne ? oneMass : _mm256_loadu_pd(g.mass + i);
         const __m256d halfMass = kOne ? halfOneMass : _mm256_mul_pd(half, m);
-        kinetic = _mm256_add_pd(kinetic, _mm256_mul_pd(halfMass, ss));
+        kinetic = addWhere<kMixed>(kinetic, _mm256_mul_pd(halfMass, ss), free);
         if constexpr (kGravity) {
             const __m256d along = _mm256_add_pd(
                 _mm256_add_pd(_mm256_mul_pd(gx, vx), _mm256_mul_pd(gy, vy)), _mm256_mul_pd(gz, vz));
-            gravityPower =
-                _mm256_add_pd(gravityPower, _mm256_mul_pd(m, _mm256_andnot_pd(sign, along)));
+            gravityPower = addWhere<kMixed>(gravityPower,
+                                            _mm256_mul_pd(m, _mm256_andnot_pd(sign, along)), free);
         }
-        const __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
+        __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
+        if constexpr (kMixed) faster = _mm256_and_pd(faster, free);
         best = _mm256_blendv_pd(best, ss, faster);
         bestAt = _mm256_blendv_pd(bestAt, at, faster);
         at = _mm256_add_pd(at, four);
     }
-    /// Particles i to i + 3 one by one, into the same chains.
-    [[gnu::target("avx2")]] void notFree(int i) {
-        double k[4], w[4];
-        _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
-        for (int l = 0; l < 4; ++l) {
-            p[l].kinetic = k[l], p[l].gravityPower = w[l];
-            guardVisit(g, i + l, p[l], s);
-        }
-        kinetic = _mm256_setr_pd(p[0].kinetic, p[1].kinetic, p[2].kinetic, p[3].kinetic);
-        gravityPower = _mm256_setr_pd(p[0].gravityPower, p[1].gravityPower, p[2].gravityPower,
-                                      p[3].gravityPower);
-        at = _mm256_add_pd(at, four);
-    }
     /// Particles [i, end) one by one into chain 0, then the chains' totals.
     [[gnu::target("avx2")]] GuardSums finish(int i, int end) {
-        double k[4], w[4], speeds[4], lanes[4];
+        double k[4], w[4], b[4], speeds[4], lanes[4];
         _mm256_storeu_pd(k, kinetic), _mm256_storeu_pd(w, gravityPower);
+        _mm256_storeu_pd(b, boundaryPower);
         _mm256_storeu_pd(speeds, best), _mm256_storeu_pd(lanes, bestAt);
-        for (int l = 0; l < 4; ++l) p[l].kinetic = k[l], p[l].gravityPower = w[l];
+        for (int l = 0; l < 4; ++l)
+            p[l].kinetic = k[l], p[l].gravityPower = w[l], p[l].boundaryPower = b[l];
         for (; i < end; ++i) guardVisit(g, i, p[0], s);
         addChains(p, s);
         for (int l = 0; l < 4; ++l) {
@@ -328,13 +384,12 @@ template <bool kOne, bool kGravity>
     GuardQuadsAvx2<kOne, kGravity> chains(g, begin);
     int i = begin;
     for (; i + 4 <= end; i += 4) {
-        if (!allFree(g.constraint + i, 4)) {
-            chains.notFree(i);
-            continue;
-        }
         __m256d vx, vy, vz;
         loadRun4(g.v + 3 * std::size_t(i), vx, vy, vz);
-        chains.free(vx, vy, vz, i);
+        if (allFree(g.constraint + i, 4))
+            chains.free(vx, vy, vz, i);
+        else
+            chains.mixed(vx, vy, vz, i);
     }
     return chains.finish(i, end);
 }
@@ -350,15 +405,16 @@ template <bool kOne, bool kFloor, bool kGravity>
     bool below = false;
     int i = begin;
     for (; i + 4 <= end; i += 4) {
-        if (!allFree(kick.k.constraint + i, 4)) {
-            for (int p = i; p < i + 4; ++p) below |= kickDriftOne(kick.k, p);
-            chains.notFree(i);
-            continue;
-        }
         __m256d vel[3], vx, vy, vz;
-        kick.free(i, vel);
-        splitRun4(vel[0], vel[1], vel[2], vx, vy, vz);
-        chains.free(vx, vy, vz, i);
+        if (allFree(kick.k.constraint + i, 4)) {
+            kick.free(i, vel);
+            splitRun4(vel[0], vel[1], vel[2], vx, vy, vz);
+            chains.free(vx, vy, vz, i);
+        } else {
+            kick.mixed(i, vel);
+            splitRun4(vel[0], vel[1], vel[2], vx, vy, vz);
+            chains.mixed(vx, vy, vz, i);
+        }
     }
     for (int p = i; p < end; ++p) below |= kickDriftOne(kick.k, p);
     belowFloor = belowFloor || below || kick.below();

@@ -191,8 +191,8 @@ GuardSums naiveGuard(const GuardInput& g, int n) {
 
 // The guard's sums at this width (ctest's kernels.* run it at each): the largest speed, its
 // lowest index, the largest |theta| and the first bad index exactly, the sums to rounding; with
-// pinned and driven particles among the free, two free particles tied at the top speed, one too
-// fast, and an infinite and a NaN theta.
+// pinned and driven particles among the free (two of them faster than any free one), two free
+// particles tied at the top speed, one too fast, and an infinite and a NaN theta.
 TEST(GuardSums, MatchTheSumsOneParticleAtATime) {
     for (const int n : {5, 64, 203}) {
         Particles p = someParticles(n);
@@ -201,6 +201,10 @@ TEST(GuardSums, MatchTheSumsOneParticleAtATime) {
         const int top = n - 3, twin = n / 2;  // twin < top, both free
         p.constraint[top] = p.constraint[twin] = -1;
         p.v[top] = Eigen::Vector3d(3.0, 4.0, 0.0), p.v[twin] = Eigen::Vector3d(0.0, 4.0, 3.0);
+        // A pinned and a driven particle faster than any free one, within the limit: neither
+        // is the fastest.
+        for (const int held : {3, 5})
+            if (held < n && p.constraint[held] != -1) p.v[held] = Eigen::Vector3d(0.0, 5.2, 0.0);
         GuardInput g{p.v.data()->data(), p.force.data()->data(),
                      p.mass.data(),      p.constraint.data(),
                      theta.data(),       30.0,

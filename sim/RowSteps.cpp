@@ -20,7 +20,7 @@ std::optional<RowSteps> rowSteps(const double* values, std::uint16_t* steps) {
         }
         const double count = r.unit > 0.0 ? std::round((values[k] - r.smallest) / r.unit) : -1.0;
         if (!(count >= 1.0 && count <= 65535.0)) return std::nullopt;
-        const double back = r.smallest + count * r.unit;  // the kernels' expression
+        const double back = r.smallest + count * r.unit;  // the kernels' (exact product)
         if (std::bit_cast<std::uint64_t>(back) != std::bit_cast<std::uint64_t>(values[k]))
             return std::nullopt;
         found[k] = std::uint16_t(count), r.stepped = true;

@@ -540,6 +540,23 @@ const std::uint8_t* PeridynamicBonds::livingRows() const {
     return livingRows_.data();
 }
 
+// Rebuilt whenever a bond broke, as livingRows(): the tile sums read a byte per tile where they
+// read its 48-96 flags.
+const std::uint8_t* PeridynamicBonds::livingTiles() const {
+    if (livingTilesVersion_ == damage_->version()) return livingTiles_.data();
+    const std::uint8_t* alive = damage_->bondAlive().data();
+    const int* offsets = bonds_.offsets.data();
+    const int n = bonds_.particleCount(), tiles = (n + kTile - 1) / kTile;
+    livingTiles_.assign(tiles, 0);
+    forEachIndex(n >= kParallelThreshold, 0, tiles, [&](int t) {
+        const int first = offsets[kTile * t], last = offsets[std::min(n, kTile * (t + 1))];
+        livingTiles_[t] =
+            std::all_of(alive + first, alive + last, [](std::uint8_t a) { return a != 0; });
+    });
+    livingTilesVersion_ = damage_->version();
+    return livingTiles_.data();
+}
+
 LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, bool breakable) const {
     LinearPairInput in{pairFirst_.data(),
                        pairSecond_.data(),
@@ -653,6 +670,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         work.blockForce.resize(3 * std::size_t(kFusedBlock) * teams);
     const std::size_t rowCount = (pairFirst_.size() + kPairTile - 1) / kPairTile;
     if (kBreak) work.over.resize(rowCount);
+    const std::uint8_t* const tileLiving = rows ? livingTiles() : nullptr;
     const LinearPairInput in = pairInput(s, kUpdateBonds, kBreak);
     LinearPairInput halo = in;  // pairs another thread owns: no history or look-ahead
     halo.update = false;
@@ -745,6 +763,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                           rows,
                           streamsForces(slab_.end - slab_.ghostBegin),
                           rowStride_};
+        gather.tileLiving = tileLiving;
         // Each block moved as soon as it is summed (StepState::motion), while its forces,
         // positions and velocities are in cache: a block's pairs read the positions of the
         // particles up to reach_ past it and never before it, so this thread reads a summed

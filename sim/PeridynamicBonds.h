@@ -211,6 +211,11 @@ private:
     mutable std::vector<std::uint8_t> livingRows_;
     mutable std::uint64_t livingVersion_ = ~std::uint64_t(0);
     const std::uint8_t* livingRows() const;
+    /// Per tile of kTile particles: whether all their bonds live (PairGather::tileLiving), as of
+    /// DamageState::version() livingTilesVersion_.
+    mutable std::vector<std::uint8_t> livingTiles_;
+    mutable std::uint64_t livingTilesVersion_ = ~std::uint64_t(0);
+    const std::uint8_t* livingTiles() const;
     std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
     std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
     std::vector<double> ratioFactor_;      ///< per bond, c*/c over the law's (maps); empty: all 1

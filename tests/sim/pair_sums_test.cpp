@@ -106,23 +106,33 @@ struct Sums {
         }
     }
     /// The sums of particles [begin, end), with or without the tiles, with their stores
-    /// around the caches or not.
-    std::vector<double> of(int begin, int end, bool withTiles, bool stream = false) const {
+    /// around the caches or not, with each tile's life in a byte (PairGather::tileLiving) or not.
+    std::vector<double> of(int begin, int end, bool withTiles, bool stream = false,
+                           bool tileBytes = false) const {
         const std::size_t size = 3 * std::size_t(bonds.particleCount());
         std::vector<double> buffer(size + 8, -7.0);
         double* force = buffer.data();  // on a 64-byte line, as streamed stores need
         while (reinterpret_cast<std::uintptr_t>(force) % 64 != 0) ++force;
-        const PairGather g{bonds.offsets.data(),
-                           pairs.upperBegin.data(),
-                           layout.slot.data(),
-                           alive.data(),
-                           slots.data() + kTile,
-                           force,
-                           ~0u,
-                           withTiles ? &tiles : nullptr,
-                           true,
-                           stream,
-                           layout.stride};
+        PairGather g{bonds.offsets.data(),
+                     pairs.upperBegin.data(),
+                     layout.slot.data(),
+                     alive.data(),
+                     slots.data() + kTile,
+                     force,
+                     ~0u,
+                     withTiles ? &tiles : nullptr,
+                     true,
+                     stream,
+                     layout.stride};
+        // Whether each tile's bonds all live, read from the flags as PeridynamicBonds does.
+        const int n = bonds.particleCount();
+        std::vector<std::uint8_t> living;
+        for (int t = 0; kTile * t < n; ++t) {
+            const int first = bonds.offsets[kTile * t],
+                      last = bonds.offsets[std::min(n, kTile * (t + 1))];
+            living.push_back(std::count(alive.begin() + first, alive.begin() + last, 0) == 0);
+        }
+        if (tileBytes) g.tileLiving = living.data();
         if (stream && withTiles && simdWidth() == 8) {
             EXPECT_TRUE(writesAround(g));
         }
@@ -144,6 +154,9 @@ void expectSameBits(const Sums& sums, int begin, int end) {
     const std::vector<double> streamed = sums.of(begin, end, true, true);
     EXPECT_EQ(std::memcmp(alone.data(), streamed.data(), alone.size() * sizeof(double)), 0)
         << "particles " << begin << " to " << end << ", stored around the caches";
+    const std::vector<double> bytes = sums.of(begin, end, true, false, true);
+    EXPECT_EQ(std::memcmp(alone.data(), bytes.data(), alone.size() * sizeof(double)), 0)
+        << "particles " << begin << " to " << end << ", each tile's life in a byte";
 }
 
 struct Case {

@@ -32,9 +32,12 @@ struct LinearPairInput {
     double stiffnessLoss = 0.0;     ///< of sim/Material.h's degradation()
     double strengthLoss = 0.0;
     /// The law (the power law with a whole exponent n of 2, 3 or 4, no maps of its parameters
-    /// or of the yield strain), with the constants of the power law copied below.
+    /// or of the yield strain), with the constants of the power and elastoplastic laws copied
+    /// below (the kernels' own copy of the input keeps them in registers: read through `law`,
+    /// every store to `held` read them again).
     const BondLaw* law = nullptr;
     double powerC = 0.0, powerCStar = 0.0, powerN = 4.0;
+    double yieldStrain = 0.0, softening = 0.0;
     /// advance(): the power law's look-ahead (needs v, dt), the elastoplastic history's update.
     bool update = false;
     /// The largest look-ahead tangent over c the caller already found (at least 1): lanes that

@@ -571,6 +571,7 @@ LinearPairInput PeridynamicBonds::pairInput(const StepState& s, bool update, boo
                        material_.params().strengthLoss};
     in.law = &law_;
     in.powerC = law_.powerC, in.powerCStar = law_.powerCStar, in.powerN = law_.powerN;
+    in.yieldStrain = law_.yieldStrain, in.softening = law_.softening;
     in.update = update;
     in.v = update ? s.v.data()->data() : nullptr, in.dt = s.dt;
     in.alive = damage_->bondAlive().data(), in.upper = pairUpper_.data();

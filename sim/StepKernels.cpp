@@ -355,7 +355,9 @@ struct GuardQuadsAvx2 {
         }
         __m256d faster = _mm256_cmp_pd(ss, best, _CMP_GT_OQ);
         if constexpr (kMixed) faster = _mm256_and_pd(faster, free);
-        best = _mm256_blendv_pd(best, ss, faster);
+        // ss > best ? ss : best, a NaN keeping best: max's bits, the blend's only where held
+        // lanes are left out.
+        best = kMixed ? _mm256_blendv_pd(best, ss, faster) : _mm256_max_pd(ss, best);
         bestAt = _mm256_blendv_pd(bestAt, at, faster);
         at = _mm256_add_pd(at, four);
     }

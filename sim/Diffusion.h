@@ -56,6 +56,9 @@ public:
     void advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
                  std::uint64_t aliveVersion, double t, double dt);
 
+    /// At least every |theta change| of the last advance() (0 before the first).
+    double lastChange() const { return lastChange_; }
+
     std::size_t spotCount() const { return spots_.size(); }
     /// The bonds' rates in tiles (sim/DiffusionKernels.h).
     const DiffusionTiles& tiles() const { return tiles_; }
@@ -79,8 +82,9 @@ private:
     };
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
-    void step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
-              std::uint64_t aliveVersion, double t, double dt);
+    /// One sub-step; returns at least every |theta change| in it.
+    double step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
+                std::uint64_t aliveVersion, double t, double dt);
 
     double K_ = 0.0;
     double stableDt_ = 0.0;
@@ -92,6 +96,8 @@ private:
     std::vector<Spot> spots_;
     std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value
     std::vector<double> scratch_;
+    std::vector<double> chunkChange_;  ///< step()'s largest change per chunk of tiles
+    double lastChange_ = 0.0;
     Domain* domain_ = nullptr;
 };
 

@@ -48,6 +48,7 @@ Membrane::Membrane(const MembraneParams& given)
     end_ = n;
     const std::vector<double> heights = perturbationHeights(sheet, x0_);
     for (int i = 0; i < n; ++i) x_[i].z() += heights[i];
+    for (const Eigen::Vector3d& x : x_) extent_ = std::max(extent_, x.cwiseAbs().maxCoeff());
     v_.assign(n, Eigen::Vector3d::Zero());
     force_.assign(n, Eigen::Vector3d::Zero());
     if (Diffusion::needed(params)) {
@@ -287,7 +288,9 @@ bool Membrane::kickAndDrift(double h, double dt, double tNext) {
 }
 
 void Membrane::collide(double tNext, bool mayTouch) {
+    collided_ = false;
     if (!contact_ || !contact_->hasColliders()) return;
+    collided_ = mayTouch;
     const double t0 = omp_get_wtime();
     contact_->place(tNext);
     if (mayTouch) {
@@ -308,9 +311,14 @@ void Membrane::accumulateForces(BlockMotion* motion, double* approachRate) {
     StepState s = stepState();
     s.stiffeningNeeded = stiffeningNeeded();
     s.motion = motion;
+    // Where a particle was at most guard_.speedLimit() for time_, it lies within
+    // positionScale.
+    s.sinceLastPass = {driftSincePass_, diffusion_ ? diffusion_->lastChange() : 0.0,
+                       extent_ + guard_.speedLimit() * time_};
     const FailureApproach approach = failureApproach();
     if (approachRate) s.approach = &approach, s.approachRate = approachRate;
     solver_->advance(s, *workspace_, force_);
+    driftSincePass_ = -1.0;
     stiffening_ = domain_ ? domain_->max(solver_->stiffening()) : solver_->stiffening();
     if (approachRate && domain_) *approachRate = domain_->max(*approachRate);
     if (params_.pressure != 0.0) addPressure(force_);
@@ -438,8 +446,9 @@ private:
 
 // Nothing may add to the forces between the solver's pass and the kick, and the step must be
 // one piece (the pass cannot take back a kick): a fixed step is cut only by the power law's
-// stiffening, which its pass never moves, and by colliders or self-contact (the ground alone
-// limits nothing, and it pushes out after the drift as before).
+// stiffening, whose pass moves only where the last pass shows it cannot cut this step
+// (PeridynamicBonds::lookAheadClear, from driftSincePass_), and by colliders or self-contact (the
+// ground alone limits nothing, and it pushes out after the drift as before).
 bool Membrane::mayKickInPass() const {
     return kickInPass_ && !chooseAfterForces_ && !solver_->carriesMomentum() &&
            params_.pressure == 0.0 && !(contact_ && contact_->limitsStep());
@@ -476,6 +485,7 @@ void Membrane::stepSymplecticEuler() {
         guard_.endMotion();
         integrate(dt_, time_ + dt_, inPass->below());
         forcesCurrent_ = false;
+        driftSincePass_ = collided_ || domain_ ? -1.0 : dt_;
         return;
     }
     double done = 0.0;
@@ -486,6 +496,7 @@ void Membrane::stepSymplecticEuler() {
         done += h;
     }
     forcesCurrent_ = false;
+    driftSincePass_ = collided_ || domain_ || pieces != 1 ? -1.0 : dt_;
 }
 
 void Membrane::stepVelocityVerlet() {
@@ -515,6 +526,7 @@ void Membrane::step() {
     if (remesher_ && (steps_ + 1) % params_.remesh.every == 0) {
         remesher_->remesh(x_, v_, mass_, damageState_.bondAlive(), free_);
         guard_.forgetMotion();
+        driftSincePass_ = -1.0;
         forcesCurrent_ = false;
     }
     if (diffusion_) {

@@ -159,16 +159,19 @@ public:
     // Writable state: the caller may change it, so cached forces are recomputed next step.
     std::vector<Eigen::Vector3d>& positions() {
         forcesCurrent_ = false;
+        driftSincePass_ = -1.0;
         return x_;
     }
     std::vector<Eigen::Vector3d>& velocities() {
         forcesCurrent_ = false;
         speedBound_ = -1.0;
+        driftSincePass_ = -1.0;
         return v_;
     }
     const std::vector<Eigen::Vector3d>& velocities() const { return v_; }
     std::vector<double>& theta() {  ///< empty without diffusion
         forcesCurrent_ = false;
+        driftSincePass_ = -1.0;
         return theta_;
     }
     const std::vector<double>& theta() const { return theta_; }
@@ -311,6 +314,12 @@ private:
     /// At least every particle's |v| since the last check (StepState::speedBound), or -1 once v
     /// may have changed: the guard's largest free speed, and the boundaries' speeds.
     double speedBound_ = -1.0;
+    /// StepState::SinceLastPass::drift: the drift of the last step where the solver's pass
+    /// came before it and nothing but the drift moved the particles since (a whole step of
+    /// symplectic Euler, no collider touched, not decomposed), else -1.
+    double driftSincePass_ = -1.0;
+    bool collided_ = false;  ///< the last collide() may have moved particles
+    double extent_ = 0.0;    ///< the largest |coordinate| of x at set-up
 };
 
 }  // namespace rend::sim

@@ -52,6 +52,7 @@ std::vector<std::byte> Membrane::saveState(std::vector<std::byte> reuse) const {
 void Membrane::loadState(std::span<const std::byte> bytes) {
     StateReader in(bytes);
     speedBound_ = -1.0;
+    driftSincePass_ = -1.0;
     visitState(*this, in);
     solver_->loadState(in);
     in.finish();

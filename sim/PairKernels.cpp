@@ -27,6 +27,8 @@ inline double wholePower(double s, double k) {
     return s * s * s;
 }
 
+inline double nearestReach(const LinearPairInput& in);
+
 // One loop per stage a scene needs, so each runs without a branch it does not need. The
 // expressions are those of the scalar loop (PeridynamicBonds::bondForcesFor, BondLaw)
 // term by term: the same bits.
@@ -38,6 +40,10 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
     const double* __restrict theta = in.theta;
     std::uint8_t* __restrict over = out.over;
     double stiffest = 1.0;
+    // LinearPairOutput::nearest, from the kernels' reach (the look-ahead here needs none).
+    constexpr bool kNearest = kLaw == BondLawKind::PowerLaw && kUpdate;
+    const double reach = kNearest && out.nearest ? nearestReach(in) : 0.0;
+    double nearest = std::numeric_limits<double>::infinity();
     for (int u = begin; u < end; ++u) {
         const int i = first[u], j = second[u];
         const double rx = x[3 * j] - x[3 * i];
@@ -68,6 +74,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
                 near = std::uint8_t((bit == 0 ? 0u : near) | 1u << bit);
             }
         }
+        if constexpr (kNearest) nearest = std::min(nearest, eta - reach * rest);
         if constexpr (kLaw == BondLawKind::PowerLaw) {  // eq. 19, and the tangent in dt
             if (kUpdate && eta < 0.0 && !past && i >= in.ownBegin && in.alive[in.upper[u]]) {
                 const double* v = in.v;
@@ -106,6 +113,7 @@ inline double pairLoop(const LinearPairInput& in, const LinearPairOutput& out, i
         slot[0] = coef * rx, slot[stride] = coef * ry, slot[2 * stride] = coef * rz;
         if (!out.rows) slot[3] = 0.0;
     }
+    if (kNearest && out.nearest) *out.nearest = std::min(*out.nearest, nearest);
     return stiffest;
 }
 
@@ -150,6 +158,12 @@ inline double lookAheadReach(const LinearPairInput& in, double stiffest, bool th
     const double t = (numerator - starNN) / (2.0 * in.powerC) - 1.0;  // 3 / s^4 where equal
     if (!(t > 0.0)) return kEverywhere;
     return std::sqrt(std::sqrt(3.0 / t)) - 1.0 + 1e-7;
+}
+
+/// The reach the kernels start from (pairLoopSimd's), for LinearPairOutput::nearest.
+inline double nearestReach(const LinearPairInput& in) {
+    return in.theta ? lookAheadReach(in, in.stiffestKnown, true)
+                    : lookAheadReach(in, in.stiffestKnown * in.c * (1.0 - 0x1p-50), false);
 }
 
 #if defined(__x86_64__)
@@ -544,6 +558,17 @@ double largestMagnitude(const double* p, std::size_t n) {
 #endif
     double largest = 0.0;
     for (std::size_t k = 0; k < n; ++k) largest = std::max(largest, std::fabs(p[k]));
+    return largest;
+}
+
+double largestChange(const double* before, const double* after, std::size_t n) {
+#if defined(__x86_64__)
+    if (simdWidth() == 8) return avx512::largestChange(before, after, n);
+    if (simdWidth() == 4) return avx2::largestChange(before, after, n);
+#endif
+    double largest = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+        largest = std::max(largest, std::fabs(after[k] - before[k]));
     return largest;
 }
 

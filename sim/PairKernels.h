@@ -149,6 +149,12 @@ struct LinearPairOutput {
     /// With LinearPairInput::skipFar: the vectors with a compressed lane within its
     /// lookAheadSlack of the reach are added to it.
     int* nearRows = nullptr;
+    /// Where not null, the power law's update lowers it to the least eta - reach x rest of the
+    /// pairs (NaN may be left out; reach: the look-ahead strain below which a pair may raise
+    /// the largest tangent, from in.stiffestKnown and rising with it). A pair whose eta falls
+    /// by less than this minus the next look-ahead's lookAheadSlack cannot raise it above
+    /// in.stiffestKnown (PeridynamicBonds::lookAheadClear).
+    double* nearest = nullptr;
 };
 
 /// The largest rate over pairs [begin, end) that live (in.alive of their upper copy), are not
@@ -168,6 +174,10 @@ double largestMagnitude(const double* p, std::size_t n);
 /// rounding: dt 2 sqrt(3) (1 + 2^-20) largest (a NaN component left out, as the look-ahead's
 /// tests leave a NaN rate out); infinity where that is not finite.
 double lookAheadSlack(double largest, double dt);
+
+/// The largest |after[k] - before[k]| of n values, simdWidth() lanes at a time (a NaN may be
+/// left out).
+double largestChange(const double* before, const double* after, std::size_t n);
 
 /// y[k] = e^x[k] as the elastoplastic kernel computes it, simdWidth() lanes at a time (the bits
 /// of sim/LawExp.h's lawExp).

@@ -78,6 +78,7 @@ void PeridynamicBonds::setUpPairArrays() {
         pairFirst_[u] = i, pairSecond_[u] = bonds_.partners[b];
         pairUpper_[u] = b, pairTwin_[u] = pairs_.twin[pairs_.pairOf[b]];
         pairRest_[u] = bonds_.restLength[b], pairScale_[u] = bondScale_[b];
+        longestRest_ = std::max(longestRest_, pairRest_[u]);
         pairLimit_[u] = criticalStretch_;
         if (!stretchFactor_.empty()) pairLimit_[u] *= stretchFactor_[b];
     };
@@ -647,11 +648,30 @@ void moveRange(BlockMotion& motion, int begin, int end) {
 
 }  // namespace
 
-// The motion a step's pass takes on: none for the power law, whose look-ahead may cut the step
-// into pieces only once every pair is seen (Membrane::piecesOfStep), after the first blocks
-// would have moved.
+// The motion a step's pass takes on. The power law's look-ahead may cut the step into pieces
+// (Membrane::piecesOfStep) only once every pair is seen, after the first blocks would have
+// moved: it takes none unless the last pass shows that no pair can reach that far.
 BlockMotion* PeridynamicBonds::movingMotion(const StepState& s) const {
-    return law_.kind == BondLawKind::PowerLaw ? nullptr : s.motion;
+    return law_.kind != BondLawKind::PowerLaw || lookAheadClear(s) ? s.motion : nullptr;
+}
+
+// A pair may raise the stiffening only where eta - reach x rest < lookAheadSlack of this step
+// (pairLoopSimd's screen). Since the last pass each length changed by at most the drift's
+// lookAheadSlack (|x_j - x_i| moved by at most |v_j - v_i| drift, and v has not changed since),
+// each eta by rest |alpha| times theta's change more, and the rounding of a position and of the
+// terms by a micro-strain of the longest bond and 2^-44 of the largest coordinate. Nothing else
+// moved the particles (StepState::SinceLastPass), and the reach is the same where the stiffening
+// asked for is.
+bool PeridynamicBonds::lookAheadClear(const StepState& s) const {
+    const StepState::SinceLastPass& since = s.sinceLastPass;
+    if (!(since.drift >= 0.0 && s.speedBound >= 0.0 && since.thetaChange >= 0.0)) return false;
+    if (nearestNeeded_ != std::max(1.0, s.stiffeningNeeded)) return false;
+    const double swelling =
+        s.theta.empty() ? 0.0 : longestRest_ * std::fabs(material_.expansion()) * since.thetaChange;
+    const double rounding = 1e-6 * longestRest_ + 0x1p-44 * since.positionScale;
+    const double left =
+        nearestGap_ - lookAheadSlack(s.speedBound, since.drift) - swelling - rounding;
+    return left >= lookAheadSlack(s.speedBound, s.dt);  // false for a NaN
 }
 
 template <bool kUpdateBonds, bool kBreak>
@@ -691,6 +711,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         work.approaching.resize(rowCount);
     }
     double fastestApproach = 0.0;
+    double nearest = std::numeric_limits<double>::infinity();  // LinearPairOutput::nearest
     // Each thread takes a run of particles and, block by block, computes their pairs into its
     // own ring of slots and at once sums them into the block's particles, while the slots are
     // in cache (a ring, so that they never go to memory). A particle's lower copies reach back
@@ -724,6 +745,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
         // The thread's own copies (328 bytes each), taken once per step rather than per block:
         // each block sets what it changes.
         LinearPairInput own = in, ghosts = halo;
+        double ownNearest = std::numeric_limits<double>::infinity();
         const auto compute = [&](LinearPairInput& input, int p, int q) {
             double most = std::max(needed, stiffest);
             int near = 0;
@@ -742,6 +764,7 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
                 out.slotBase = base, out.rows = rows;
                 if (approach && &input == &own)
                     out.approaching = work.approaching.data(), out.approach = &approach->second;
+                if (lookAhead && &input == &own) out.nearest = &ownNearest;
                 if (rows) out.rowSlot = rowSlot_.data(), out.stride = rowStride_;
                 out.nearRows = &near;
                 most = std::max(most, linearPairForces(input, out, u, stop));
@@ -810,9 +833,13 @@ void PeridynamicBonds::vectorBondForces(const StepState& s, PairWorkspace& work,
             moveRange(*motion, std::max(from, slab_.begin), settled);
         }
 #pragma omp critical(rend_approach)
-        fastestApproach = std::max(fastestApproach, approaching);
+        {
+            fastestApproach = std::max(fastestApproach, approaching);
+            nearest = std::min(nearest, ownNearest);
+        }
     });
     if (approach) *s.approachRate = fastestApproach;
+    if (kUpdateBonds && law_.kind == BondLawKind::PowerLaw) updates.nearest = nearest;
     updates.breaking = kUpdateBonds && kBreak ? proposeBreaks(work.over, updates.proposed) : 0;
     updates.stiffest = stiffest;
 }
@@ -888,7 +915,11 @@ void PeridynamicBonds::advance(const StepState& s, Workspace& work,
     Updates updates{plastic_.data(), damage_->proposals()};
     bondForces<true>(s, work, force, updates);
     if (updates.breaking > 0) damage_->applyProposals();
-    if (law_.kind == BondLawKind::PowerLaw) stiffening_ = updates.stiffest;
+    if (law_.kind != BondLawKind::PowerLaw) return;
+    stiffening_ = updates.stiffest;
+    nearestNeeded_ = std::max(1.0, s.stiffeningNeeded);
+    nearestGap_ = updates.stiffest == nearestNeeded_ ? updates.nearest
+                                                     : -std::numeric_limits<double>::infinity();
 }
 
 std::pair<LinearPairInput, ApproachRate> PeridynamicBonds::approachInput(

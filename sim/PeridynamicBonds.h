@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <utility>
@@ -114,6 +115,8 @@ private:
         std::uint8_t* proposed = nullptr;
         int breaking = 0;       ///< out: the bonds proposed
         double stiffest = 1.0;  ///< out: the largest look-ahead tangent x stiffness factor, over c
+        /// out: the vectorised power law's LinearPairOutput::nearest over its pairs
+        double nearest = -std::numeric_limits<double>::infinity();
     };
     /// The scratch of the force loop: each pair's force on its smaller index (the linear law's
     /// as three arrays, and whether it is past its limit).
@@ -232,6 +235,15 @@ private:
     }
     double stiffening_ = 1.0;  ///< the most compressed bond's, over c (advance() only)
     Slab slab_;                ///< what this process computes; all of the sheet by default
+    /// The power law's last advance(): the least eta - reach x rest of its pairs
+    /// (LinearPairOutput::nearest) where its look-ahead found nothing above the stiffening
+    /// asked for, `nearestNeeded_` (else -infinity), and the longest rest length.
+    double nearestGap_ = -std::numeric_limits<double>::infinity(), nearestNeeded_ = 0.0;
+    double longestRest_ = 0.0;
+    /// Whether the power law's look-ahead in this pass cannot raise the stiffening above
+    /// s.stiffeningNeeded (so the pass may move the particles): from the last pass's nearest
+    /// gap and how far the particles and theta moved since (StepState::sinceLastPass).
+    bool lookAheadClear(const StepState& s) const;
 };
 
 }  // namespace rend::sim

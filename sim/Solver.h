@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -61,6 +62,15 @@ struct StepState {
     /// At least every particle's speed |v|, or < 0 where unknown (Membrane::speedBound): the
     /// power law's look-ahead then bounds its pairs' rates from it instead of reading v.
     double speedBound = -1.0;
+    /// What changed since the solver's last advance() (Membrane::driftSincePass_): each
+    /// particle moved only by a drift of `drift` seconds at its present velocity (so at most
+    /// drift x speedBound), and theta by at most thetaChange; < 0 where unknown. positionScale
+    /// is at least every |coordinate| of x.
+    struct SinceLastPass {
+        double drift = -1.0, thetaChange = -1.0;
+        double positionScale = std::numeric_limits<double>::infinity();
+    };
+    SinceLastPass sinceLastPass{};
     /// Non-null: advance() may move the particles through it instead of leaving that to the
     /// caller (the caller asks the motion whether it moved them). forces() never does.
     BlockMotion* motion = nullptr;

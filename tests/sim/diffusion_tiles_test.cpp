@@ -226,6 +226,39 @@ TEST(DiffusionTiles, FollowTheBondsAsTheyBreak) {
     EXPECT_EQ(a, b);
 }
 
+// Diffusion::lastChange() bounds every |theta change| of the last advance(), sub-steps, spots
+// (two overlapping, one a sink) and held edges included, and is no more than the sum of each
+// sub-step's largest diffusion and the spots' dt |rate| (the held edge's jump is larger).
+TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
+    Sheet sheet;
+    sheet.params.diffusion.spots.push_back({{0.0, 0.0}, 0.05, 30.0});
+    sheet.params.diffusion.spots.push_back({{0.02, 0.0}, 0.05, -10.0});
+    const int n = sheet.bonds.particleCount();
+    Diffusion diffusion(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    DamageState damage(sheet.bonds, sheet.lattice.triangles);
+    std::vector<double> theta(n);
+    for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(9, i);
+    EXPECT_EQ(diffusion.lastChange(), 0.0);
+    for (const double steps : {0.5, 2.5}) {  // one sub-step, then three
+        const double dt = steps * diffusion.stableTimeStep();
+        const std::vector<double> before = theta;
+        diffusion.advance(theta, damage.bondAlive(), damage.version(), 0.0, dt);
+        double largest = 0.0;
+        for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(theta[i] - before[i]));
+        EXPECT_GE(diffusion.lastChange(), largest) << steps;
+        EXPECT_LE(diffusion.lastChange(), 3.0 * largest + 40.0 * dt) << steps;
+    }
+    sheet.params.diffusion.edges.push_back({});
+    sheet.params.diffusion.edges.back().value = 50.0;
+    Diffusion held(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    const std::vector<double> before = theta;
+    held.advance(theta, damage.bondAlive(), damage.version(), 0.0, 0.5 * held.stableTimeStep());
+    double largest = 0.0;
+    for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(theta[i] - before[i]));
+    EXPECT_GT(largest, 40.0);
+    EXPECT_GE(held.lastChange(), largest);
+}
+
 }  // namespace
 
 namespace {

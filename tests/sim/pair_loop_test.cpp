@@ -378,6 +378,22 @@ TEST(PairLoop, TheLookAheadSlackBoundsEveryPairsRelativeVelocity) {
     EXPECT_GT(lookAheadSlack(0.0, 1e-4), 0.0);
 }
 
+// largestChange: the largest |after - before| of n values at every width and length (the lanes
+// and the rest).
+TEST(PairLoop, TheLargestChangeIsTheLargestDifference) {
+    for (const int n : {0, 1, 3, 4, 9, 100, 333}) {
+        std::vector<double> before(n), after(n);
+        double largest = 0.0;
+        for (int k = 0; k < n; ++k) {
+            before[k] = uniformFromHash(41, k), after[k] = uniformFromHash(42, k);
+            largest = std::max(largest, std::abs(after[k] - before[k]));
+        }
+        EXPECT_EQ(largestChange(before.data(), after.data(), n), largest) << n;
+        if (n > 0) after[n - 1] = before[n - 1] - 3.0;
+        if (n > 0) EXPECT_EQ(largestChange(before.data(), after.data(), n), 3.0) << n;
+    }
+}
+
 // advance() moves the elastoplastic history on in the kernel: both copies of every living,
 // unbroken bond hold the largest strain it has seen, and a dead bond's history stays put.
 TEST(PairLoop, TheElastoplasticHistoryHoldsEachLivingBondsLargestStrain) {

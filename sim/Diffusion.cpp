@@ -176,13 +176,14 @@ double Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t>
     const double* now = theta.data();
     double* next = scratch_.data();
     // The largest change of each chunk, read back while it is in cache (lastChange()).
-    chunkChange_.assign(std::max(chunks, 0), 0.0);
+    chunkChange_.assign(measure_ ? std::max(chunks, 0) : 0, 0.0);
     forEachIndex(n >= kParallelThreshold, 0, chunks, [&](int c) {
         const int begin = firstTile + c * kChunk, end = std::min(lastTile, begin + kChunk);
         diffuseTiles(tiles_, now, next, dt, begin, end);
-        chunkChange_[c] =
-            largestChange(now + kTile * std::size_t(begin), next + kTile * std::size_t(begin),
-                          kTile * std::size_t(end - begin));
+        if (measure_)
+            chunkChange_[c] =
+                largestChange(now + kTile * std::size_t(begin), next + kTile * std::size_t(begin),
+                              kTile * std::size_t(end - begin));
     });
     double change = 0.0;
     for (const double c : chunkChange_) change = std::max(change, c);
@@ -190,9 +191,9 @@ double Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t>
               tailBegin = std::max(first, kTile * lastTile);
     for (int i = first; i < headEnd; ++i) diffuseParticle(tiles_, now, next, dt, i);
     for (int i = tailBegin; i < last; ++i) diffuseParticle(tiles_, now, next, dt, i);
-    if (first < headEnd)
+    if (measure_ && first < headEnd)
         change = std::max(change, largestChange(now + first, next + first, headEnd - first));
-    if (tailBegin < last)
+    if (measure_ && tailBegin < last)
         change =
             std::max(change, largestChange(now + tailBegin, next + tailBegin, last - tailBegin));
     theta.swap(scratch_);

@@ -56,8 +56,12 @@ public:
     void advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
                  std::uint64_t aliveVersion, double t, double dt);
 
-    /// At least every |theta change| of the last advance() (0 before the first).
-    double lastChange() const { return lastChange_; }
+    /// At least every |theta change| of the last advance() (0 before the first), where
+    /// measureChanges() asked for it; else -1.
+    double lastChange() const { return measure_ ? lastChange_ : -1.0; }
+    /// From now on, advance() measures lastChange() (about 1% of a step at 10^4 particles: the
+    /// power law's look-ahead reads it, PeridynamicBonds::lookAheadClear).
+    void measureChanges() { measure_ = true; }
 
     std::size_t spotCount() const { return spots_.size(); }
     /// The bonds' rates in tiles (sim/DiffusionKernels.h).
@@ -82,7 +86,7 @@ private:
     };
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
-    /// One sub-step; returns at least every |theta change| in it.
+    /// One sub-step; returns at least every |theta change| in it where measure_, else 0.
     double step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
                 std::uint64_t aliveVersion, double t, double dt);
 
@@ -98,6 +102,7 @@ private:
     std::vector<double> scratch_;
     std::vector<double> chunkChange_;  ///< step()'s largest change per chunk of tiles
     double lastChange_ = 0.0;
+    bool measure_ = false;
     Domain* domain_ = nullptr;
 };
 

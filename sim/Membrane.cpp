@@ -54,6 +54,7 @@ Membrane::Membrane(const MembraneParams& given)
     if (Diffusion::needed(params)) {
         diffusion_.emplace(params, x0_, bonds_, volume_);
         theta_ = diffusion_->initialTheta();
+        if (params.material.law == BondLawKind::PowerLaw) diffusion_->measureChanges();
     }
     if (params.contact.any()) setUpContact(params);
     if (params.remesh.every > 0) remesher_.emplace(x0_, bonds_, sheet.dx);

@@ -311,7 +311,9 @@ struct Lanes3 {
 /// every tile in rows by k), so that it is straight code: the branches on each row's runs and
 /// on whether it is a lower copy, predicted or not, cost 0.4 of the sums' 2.7 ns per particle
 /// (crack_path_sources at 10^4, linear, 10.69 -> 10.31 with the first alone, timing only).
-template <int kBonds, bool kRegular>
+/// kLiving: every bond of the tile lives (PairGather::tileLiving), so its flags are not read
+/// and every lane adds (the masked adds' bits with every lane on).
+template <int kBonds, bool kRegular, bool kLiving>
 [[REND_TILE_TARGET]] void sumWholeTile(const PairGather& g, const PairSumTiles::Row* row,
                                        int lowerCopies, const std::uint8_t* alive, double* out,
                                        bool stream) {
@@ -323,14 +325,17 @@ template <int kBonds, bool kRegular>
         for (int l = 0; l < kTile; ++l) stride |= std::uint64_t(1) << (l * kBonds);
         return stride;
     }();
-    const __m512i bytes = _mm512_maskz_loadu_epi8(kFlags, alive);
-    const std::uint64_t life = _mm512_test_epi8_mask(bytes, bytes);
+    std::uint64_t life = ~std::uint64_t(0);
+    if constexpr (!kLiving) {
+        const __m512i bytes = _mm512_maskz_loadu_epi8(kFlags, alive);
+        life = _mm512_test_epi8_mask(bytes, bytes);
+    }
     __m512d x = _mm512_setzero_pd(), y = x, z = x;
 #pragma GCC unroll 8
     for (int k = 0; k < kBonds; ++k) {
         const double *a = g.pairForce + row[k].atA, *b = g.pairForce + row[k].atB;
         const __mmask8 fromA = kRegular ? 0xff : row[k].fromA;
-        const __mmask8 on = __mmask8(_pext_u64(life, kStride << k));
+        const __mmask8 on = kLiving ? __mmask8(0xff) : __mmask8(_pext_u64(life, kStride << k));
         const __m512d fx = wholeRow(a, b, fromA, 0), fy = wholeRow(a, b, fromA, g.stride);
         const __m512d fz = wholeRow(a, b, fromA, 2 * g.stride);
         if (k < lower) {
@@ -389,15 +394,24 @@ template <int kBonds, bool kRegular>
         const PairSumTiles::Row* rows = s.rows.data() + one.rowFirst;
         const std::uint8_t* alive = g.alive + g.offsets[kTile * t];
         double* out = g.forceOf(kTile * t);
-        switch (one.bonds + (one.regular ? 100 : 0)) {  // the square lattice's 8, hexagonal's 6
+        // The square lattice's 8, hexagonal's 6; whether all live, a byte a tile where the
+        // caller keeps them.
+        const bool living = g.tileLiving && g.tileLiving[t] != 0;
+        switch (one.bonds + (one.regular ? 100 : 0) + (living ? 1000 : 0)) {
+            case 1108:
+                return sumWholeTile<8, true, true>(g, rows, one.lower, alive, out, stream);
             case 108:
-                return sumWholeTile<8, true>(g, rows, one.lower, alive, out, stream);
+                return sumWholeTile<8, true, false>(g, rows, one.lower, alive, out, stream);
+            case 1008:
             case 8:
-                return sumWholeTile<8, false>(g, rows, one.lower, alive, out, stream);
+                return sumWholeTile<8, false, false>(g, rows, one.lower, alive, out, stream);
+            case 1106:
+                return sumWholeTile<6, true, true>(g, rows, one.lower, alive, out, stream);
             case 106:
-                return sumWholeTile<6, true>(g, rows, one.lower, alive, out, stream);
+                return sumWholeTile<6, true, false>(g, rows, one.lower, alive, out, stream);
+            case 1006:
             case 6:
-                return sumWholeTile<6, false>(g, rows, one.lower, alive, out, stream);
+                return sumWholeTile<6, false, false>(g, rows, one.lower, alive, out, stream);
             default:
                 break;
         }
@@ -436,7 +450,7 @@ template <int kBonds, bool kRegular>
         __builtin_prefetch(rows);
         __builtin_prefetch(rows + 64);  // a tile's eight rows: 96 bytes
     }
-    __builtin_prefetch(g.alive + g.offsets[kTile * t]);
+    if (!g.tileLiving || g.tileLiving[t] == 0) __builtin_prefetch(g.alive + g.offsets[kTile * t]);
 }
 
 [[REND_TILE_TARGET]] void gatherTiles(const PairGather& input, int begin, int end) {

@@ -84,7 +84,7 @@ struct PairGather {
     int stride = 8;  ///< in rows: from a slot's x to its y
     int forceFirst = 0;
     /// Per tile of kTile particles: nonzero where all its bonds live (as of the life flags'
-    /// version: PeridynamicBonds::livingTiles()); null: the four-lane sums read the tile's flags.
+    /// version: PeridynamicBonds::livingTiles()); null: the sums read the tile's flags.
     const std::uint8_t* tileLiving = nullptr;
     /// Particle i's x y z.
     double* forceOf(int i) const { return force + 3 * (std::ptrdiff_t(i) - forceFirst); }

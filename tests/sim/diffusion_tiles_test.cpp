@@ -238,6 +238,8 @@ TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
     DamageState damage(sheet.bonds, sheet.lattice.triangles);
     std::vector<double> theta(n);
     for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(9, i);
+    EXPECT_EQ(diffusion.lastChange(), -1.0) << "not asked for";
+    diffusion.measureChanges();
     EXPECT_EQ(diffusion.lastChange(), 0.0);
     for (const double steps : {0.5, 2.5}) {  // one sub-step, then three
         const double dt = steps * diffusion.stableTimeStep();
@@ -251,6 +253,7 @@ TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
     sheet.params.diffusion.edges.push_back({});
     sheet.params.diffusion.edges.back().value = 50.0;
     Diffusion held(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    held.measureChanges();
     const std::vector<double> before = theta;
     held.advance(theta, damage.bondAlive(), damage.version(), 0.0, 0.5 * held.stableTimeStep());
     double largest = 0.0;

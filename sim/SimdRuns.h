@@ -14,16 +14,23 @@ namespace rend::sim {
     return _mm512_permutex2var_pd(low, from, high);
 }
 
-[[gnu::always_inline, gnu::target("avx2,avx512f")]] inline void loadRun8(const double* p,
-                                                                         __m512d& x, __m512d& y,
-                                                                         __m512d& z) {
-    const __m512d a = _mm512_loadu_pd(p), b = _mm512_loadu_pd(p + 8), c = _mm512_loadu_pd(p + 16);
+/// Eight particles' x y z (a = x0 y0 z0 x1 y1 z1 x2 y2, b and c the next sixteen) as three
+/// lanes.
+[[gnu::always_inline, gnu::target("avx2,avx512f")]] inline void splitRun8(__m512d a, __m512d b,
+                                                                          __m512d c, __m512d& x,
+                                                                          __m512d& y, __m512d& z) {
     x = pickLanes(pickLanes(a, b, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0)), c,
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13));
     y = pickLanes(pickLanes(a, b, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0)), c,
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14));
     z = pickLanes(pickLanes(a, b, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0)), c,
                   _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15));
+}
+
+[[gnu::always_inline, gnu::target("avx2,avx512f")]] inline void loadRun8(const double* p,
+                                                                         __m512d& x, __m512d& y,
+                                                                         __m512d& z) {
+    splitRun8(_mm512_loadu_pd(p), _mm512_loadu_pd(p + 8), _mm512_loadu_pd(p + 16), x, y, z);
 }
 
 // Four particles' x y z (x0 y0 z0 x1 y1 z1 x2 y2 z2 x3 y3 z3) as three lanes: each 128-bit half

@@ -230,52 +230,106 @@ int kickDriftAvx2(const KickDrift& k, int begin, int end, bool& belowFloor) {
                : kickQuadsAvx2<false, false>(k, begin, end, belowFloor);
 }
 
-// Eight free particles are twenty-four doubles, three lanes of eight, the masses and gravity
-// spread by permutes.
-[[gnu::target("avx2,avx512f")]] int kickDriftAvx512(const KickDrift& input, int begin, int end,
-                                                    bool& belowFloor) {
-    const KickDrift k = input;  // its own copy: the stores to x and v cannot alias it
-    bool below = false;         // nor this (kickDriftAvx2's)
-    const __m512d h = _mm512_set1_pd(k.h), dt = _mm512_set1_pd(k.dt);
-    const __m512d damping = _mm512_set1_pd(k.damping), floor = _mm512_set1_pd(k.floor);
-    const __m512d g = _mm512_setr_pd(k.gravity[0], k.gravity[1], k.gravity[2], 0, 0, 0, 0, 0);
-    // Component (3 p + a) of lane l: particle p = (8 l + slot) / 3, axis a = (8 l + slot) % 3.
-    const __m512i particle[3] = {_mm512_setr_epi64(0, 0, 0, 1, 1, 1, 2, 2),
-                                 _mm512_setr_epi64(2, 3, 3, 3, 4, 4, 4, 5),
-                                 _mm512_setr_epi64(5, 5, 6, 6, 6, 7, 7, 7)};
-    const __m512i axis[3] = {_mm512_setr_epi64(0, 1, 2, 0, 1, 2, 0, 1),
-                             _mm512_setr_epi64(2, 0, 1, 2, 0, 1, 2, 0),
-                             _mm512_setr_epi64(1, 2, 0, 1, 2, 0, 1, 2)};
-    constexpr __mmask8 kZLanes[3] = {0b00100100, 0b01001001, 0b10010010};
-    // One mass for the sheet: its 8 bytes a particle not streamed (10^6 particles, interleaved:
-    // crack_path_sources, linear law, 13.86 -> 13.51 ns, power law 15.68 -> 15.32).
-    const bool one = k.oneMass > 0.0;
-    const __m512d oneMass = _mm512_set1_pd(k.oneMass);
-    int i = begin;
-    for (; i + 8 <= end; i += 8) {
-        if (!allFree(k.constraint + i, 8)) {
-            for (int p = i; p < i + 8; ++p) below |= kickDriftOne(k, p);
-            continue;
+// Eight particles are twenty-four doubles, three lanes of eight, the masses and gravity spread
+// by permutes (KickQuadsAvx2's, at eight lanes): an octet with a pinned or driven particle is
+// kicked as if free and theirs then take their prescribed velocities by a masked blend.
+template <bool kOne, bool kFloor>
+struct KickOctetsAvx512 {
+    const KickDrift k;  // its own copy (KickQuadsAvx2's)
+    __m512d h, dt, damping, floor, oneMass, gravity[3];
+    __m512i particle[3];
+    unsigned below = 0;
+    /// Component (3 p + a) of lane l: particle p = (8 l + slot) / 3, axis a = (8 l + slot) % 3.
+    static constexpr __mmask8 kZLanes[3] = {0b00100100, 0b01001001, 0b10010010};
+
+    [[gnu::target("avx2,avx512f")]] explicit KickOctetsAvx512(const KickDrift& input) : k(input) {
+        h = _mm512_set1_pd(k.h), dt = _mm512_set1_pd(k.dt);
+        damping = _mm512_set1_pd(k.damping), floor = _mm512_set1_pd(k.floor);
+        oneMass = _mm512_set1_pd(k.oneMass);
+        const __m512d g = _mm512_setr_pd(k.gravity[0], k.gravity[1], k.gravity[2], 0, 0, 0, 0, 0);
+        const __m512i axis[3] = {_mm512_setr_epi64(0, 1, 2, 0, 1, 2, 0, 1),
+                                 _mm512_setr_epi64(2, 0, 1, 2, 0, 1, 2, 0),
+                                 _mm512_setr_epi64(1, 2, 0, 1, 2, 0, 1, 2)};
+        particle[0] = _mm512_setr_epi64(0, 0, 0, 1, 1, 1, 2, 2);
+        particle[1] = _mm512_setr_epi64(2, 3, 3, 3, 4, 4, 4, 5);
+        particle[2] = _mm512_setr_epi64(5, 5, 6, 6, 6, 7, 7, 7);
+        for (int lane = 0; lane < 3; ++lane) gravity[lane] = _mm512_permutexvar_pd(axis[lane], g);
+    }
+    /// The components of particles i to i + 7 that are not free, and their velocities (pinned:
+    /// 0); their forces copied where a block kept them (KickDrift::keptForce).
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void prescribedOf(
+        int i, __mmask8 (&held)[3], __m512d (&prescribed)[3]) const {
+        alignas(64) double velocity[24];
+        unsigned tags = 0;
+        for (int p = 0; p < 8; ++p) {
+            const std::int16_t c = k.constraint[i + p];
+            for (int a = 0; a < 3; ++a)
+                velocity[3 * p + a] = c >= 0 ? k.boundaryVelocity[3 * c + a] : 0.0;
+            if (c == kFree) continue;
+            tags |= 7u << (3 * p);
+            if (k.keptForce)
+                for (int a = 0; a < 3; ++a) k.keptForce[3 * (i + p) + a] = k.forceOf(i + p)[a];
         }
-        const __m512d masses = one ? oneMass : _mm512_loadu_pd(k.mass + i);
+        for (int lane = 0; lane < 3; ++lane) {
+            prescribed[lane] = _mm512_load_pd(velocity + 8 * lane);
+            held[lane] = __mmask8(tags >> (8 * lane));
+        }
+    }
+    /// Particles i to i + 7 kicked and drifted (kickDriftOne's bits in every lane); their new
+    /// velocities in `vel`'s lanes. kMixed: some are pinned or driven.
+    template <bool kMixed>
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void octet(int i, __m512d (&vel)[3]) {
+        __mmask8 held[3] = {0, 0, 0};
+        __m512d prescribed[3];
+        if constexpr (kMixed) prescribedOf(i, held, prescribed);
+        const __m512d masses = kOne ? oneMass : _mm512_loadu_pd(k.mass + i);
         for (int lane = 0; lane < 3; ++lane) {
             double* v = k.v + 3 * i + 8 * lane;
             double* x = k.x + 3 * i + 8 * lane;
-            const __m512d mass = one ? oneMass : _mm512_permutexvar_pd(particle[lane], masses);
-            const __m512d gravity = _mm512_permutexvar_pd(axis[lane], g);
+            const __m512d mass = kOne ? oneMass : _mm512_permutexvar_pd(particle[lane], masses);
             const __m512d f = _mm512_loadu_pd(k.forceOf(i) + 8 * lane);
-            __m512d vel = _mm512_loadu_pd(v);
+            __m512d u = _mm512_loadu_pd(v);
             const __m512d acceleration = _mm512_sub_pd(
-                _mm512_add_pd(_mm512_div_pd(f, mass), gravity), _mm512_mul_pd(damping, vel));
-            vel = _mm512_add_pd(vel, _mm512_mul_pd(h, acceleration));
-            _mm512_storeu_pd(v, vel);
-            const __m512d to = _mm512_add_pd(_mm512_loadu_pd(x), _mm512_mul_pd(dt, vel));
+                _mm512_add_pd(_mm512_div_pd(f, mass), gravity[lane]), _mm512_mul_pd(damping, u));
+            u = _mm512_add_pd(u, _mm512_mul_pd(h, acceleration));
+            if constexpr (kMixed) u = _mm512_mask_blend_pd(held[lane], u, prescribed[lane]);
+            _mm512_storeu_pd(v, u);
+            const __m512d to = _mm512_add_pd(_mm512_loadu_pd(x), _mm512_mul_pd(dt, u));
             _mm512_storeu_pd(x, to);
-            below |= _mm512_mask_cmp_pd_mask(kZLanes[lane], to, floor, _CMP_NGE_UQ) != 0;
+            if constexpr (kFloor)
+                below |= _mm512_mask_cmp_pd_mask(__mmask8(kZLanes[lane] & ~held[lane]), to, floor,
+                                                 _CMP_NGE_UQ);
+            vel[lane] = u;
         }
     }
-    belowFloor = belowFloor || below;
+};
+
+// One mass for the sheet (its 8 bytes a particle not streamed: 10^6 particles, interleaved,
+// crack_path_sources, linear law, 13.86 -> 13.51 ns, power law 15.68 -> 15.32) and a floor are
+// constants of the loop.
+template <bool kOne, bool kFloor>
+[[gnu::target("avx2,avx512f")]] int kickOctetsAvx512(const KickDrift& input, int begin, int end,
+                                                     bool& belowFloor) {
+    KickOctetsAvx512<kOne, kFloor> kick(input);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        __m512d vel[3];
+        if (allFree(kick.k.constraint + i, 8))
+            kick.template octet<false>(i, vel);
+        else
+            kick.template octet<true>(i, vel);
+    }
+    belowFloor = belowFloor || kick.below != 0;
     return i;
+}
+
+int kickDriftAvx512(const KickDrift& k, int begin, int end, bool& belowFloor) {
+    const bool one = k.oneMass > 0.0, floor = k.floor != -std::numeric_limits<double>::infinity();
+    if (floor)
+        return one ? kickOctetsAvx512<true, true>(k, begin, end, belowFloor)
+                   : kickOctetsAvx512<false, true>(k, begin, end, belowFloor);
+    return one ? kickOctetsAvx512<true, false>(k, begin, end, belowFloor)
+               : kickOctetsAvx512<false, false>(k, begin, end, belowFloor);
 }
 
 // Four particles at a time, lane k the scalar loop's chain k (guardScalar's): the same bits.
@@ -423,21 +477,6 @@ template <bool kOne, bool kFloor, bool kGravity>
     return chains.finish(i, end);
 }
 
-template <bool kOne, bool kFloor>
-GuardSums kickGuardGravityAvx2(const KickDrift& k, const GuardInput& g, int begin, int end,
-                               bool& below) {
-    return g.hasGravity ? kickGuardQuadsAvx2<kOne, kFloor, true>(k, g, begin, end, below)
-                        : kickGuardQuadsAvx2<kOne, kFloor, false>(k, g, begin, end, below);
-}
-
-template <bool kOne>
-GuardSums kickGuardFloorAvx2(const KickDrift& k, const GuardInput& g, int begin, int end,
-                             bool& below) {
-    return k.floor != -std::numeric_limits<double>::infinity()
-               ? kickGuardGravityAvx2<kOne, true>(k, g, begin, end, below)
-               : kickGuardGravityAvx2<kOne, false>(k, g, begin, end, below);
-}
-
 GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
     const bool one = g.oneMass > 0.0;
     if (g.hasGravity)
@@ -474,59 +513,161 @@ GuardSums guardAvx2(const GuardInput& g, int begin, int end) {
     return ((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]));
 }
 
-// Eight free particles at a time, one chain per lane; the others, and the tail, one at a time
-// in a chain of their own. The lanes' largest speeds and their indices meet at the end, the
-// lowest index winning a tie.
-[[gnu::target("avx2,avx512f")]] GuardSums guardAvx512(const GuardInput& g, int begin, int end) {
+/// Eight chains, one a lane, of eight particles at a time from `begin` (GuardQuadsAvx2's at eight
+/// lanes): a free octet's velocities in lanes (free()), an octet with a particle that is not free
+/// by each lane's tag (mixed()), then the tail one at a time in a chain of its own and the totals
+/// (finish()). The lanes' largest speeds and their indices meet at the end, the lowest index
+/// winning a tie.
+template <bool kOne, bool kGravity>
+struct GuardOctetsAvx512 {
+    const GuardInput& g;
     GuardSums s;
     GuardPart p;
-    const __m512d half = _mm512_set1_pd(0.5), limit = _mm512_set1_pd(g.limitSquared);
-    const __m512d gx = _mm512_set1_pd(g.gravity[0]), gy = _mm512_set1_pd(g.gravity[1]);
-    const __m512d gz = _mm512_set1_pd(g.gravity[2]);
-    const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
-    __m512d kinetic = _mm512_setzero_pd(), gravityPower = _mm512_setzero_pd();
-    __m512d best = _mm512_setzero_pd();
-    __m512i bestAt = _mm512_set1_epi64(-1);
-    const bool one = g.oneMass > 0.0;
-    const __m512d oneMass = _mm512_set1_pd(g.oneMass);
-    int i = begin;
-    for (; i + 8 <= end; i += 8) {
-        if (!allFree(g.constraint + i, 8)) {
-            for (int q = i; q < i + 8; ++q) guardVisit(g, q, p, s);
-            continue;
-        }
-        __m512d vx, vy, vz;
-        loadRun8(g.v + 3 * i, vx, vy, vz);
+    __m512d half, limit, gx, gy, gz, oneMass, halfOneMass;
+    __m512d kinetic, gravityPower, boundaryPower, best;
+    __m512i bestAt, at;
+
+    [[gnu::target("avx2,avx512f")]] GuardOctetsAvx512(const GuardInput& input, int begin)
+        : g(input) {
+        half = _mm512_set1_pd(0.5), limit = _mm512_set1_pd(g.limitSquared);
+        gx = _mm512_set1_pd(g.gravity[0]), gy = _mm512_set1_pd(g.gravity[1]);
+        gz = _mm512_set1_pd(g.gravity[2]);
+        oneMass = _mm512_set1_pd(g.oneMass), halfOneMass = _mm512_mul_pd(half, oneMass);
+        kinetic = gravityPower = boundaryPower = best = _mm512_setzero_pd();
+        bestAt = _mm512_set1_epi64(-1);
+        at = _mm512_add_epi64(_mm512_set1_epi64(begin), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+    }
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void free(__m512d vx, __m512d vy,
+                                                                  __m512d vz, int i) {
+        visit<false>(vx, vy, vz, i, 0xff);
+    }
+    /// Particles i to i + 7, some pinned or driven (guardVisit's terms by each lane's tag): the
+    /// driven add |f . v| to their chain's boundary power, the free as free().
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void mixed(__m512d vx, __m512d vy,
+                                                                   __m512d vz, int i) {
+        const __m512i tags = _mm512_cvtepi16_epi64(
+            _mm_loadu_si128(reinterpret_cast<const __m128i*>(g.constraint + i)));
+        const __m512i freeTag = _mm512_set1_epi64(kFree);
+        const __mmask8 free = _mm512_cmpeq_epi64_mask(tags, freeTag);
+        const __mmask8 driven = _mm512_cmpgt_epi64_mask(tags, freeTag);
+        __m512d fx, fy, fz;
+        loadRun8(g.force + 3 * std::size_t(i), fx, fy, fz);
+        const __m512d power = _mm512_abs_pd(_mm512_add_pd(
+            _mm512_add_pd(_mm512_mul_pd(fx, vx), _mm512_mul_pd(fy, vy)), _mm512_mul_pd(fz, vz)));
+        boundaryPower = _mm512_mask_add_pd(boundaryPower, driven, boundaryPower, power);
+        visit<true>(vx, vy, vz, i, free);
+    }
+    /// With kMixed, only the lanes of `free` are free.
+    template <bool kMixed>
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void visit(__m512d vx, __m512d vy,
+                                                                   __m512d vz, int i,
+                                                                   __mmask8 free) {
         const __m512d ss = _mm512_add_pd(
             _mm512_add_pd(_mm512_mul_pd(vx, vx), _mm512_mul_pd(vy, vy)), _mm512_mul_pd(vz, vz));
         const unsigned bad = _mm512_cmp_pd_mask(ss, limit, _CMP_NLE_UQ);
         if (bad != 0 && s.firstBad < 0) s.firstBad = i + __builtin_ctz(bad);
-        const __m512d m = one ? oneMass : _mm512_loadu_pd(g.mass + i);
-        kinetic = _mm512_add_pd(kinetic, _mm512_mul_pd(_mm512_mul_pd(half, m), ss));
-        if (g.hasGravity) {
+        const __m512d m = kOne ? oneMass : _mm512_loadu_pd(g.mass + i);
+        const __m512d energy = _mm512_mul_pd(kOne ? halfOneMass : _mm512_mul_pd(half, m), ss);
+        kinetic = kMixed ? _mm512_mask_add_pd(kinetic, free, kinetic, energy)
+                         : _mm512_add_pd(kinetic, energy);
+        if constexpr (kGravity) {
             const __m512d along = _mm512_add_pd(
                 _mm512_add_pd(_mm512_mul_pd(gx, vx), _mm512_mul_pd(gy, vy)), _mm512_mul_pd(gz, vz));
-            gravityPower = _mm512_add_pd(gravityPower, _mm512_mul_pd(m, _mm512_abs_pd(along)));
+            const __m512d power = _mm512_mul_pd(m, _mm512_abs_pd(along));
+            gravityPower = kMixed ? _mm512_mask_add_pd(gravityPower, free, gravityPower, power)
+                                  : _mm512_add_pd(gravityPower, power);
         }
-        const __mmask8 faster = _mm512_cmp_pd_mask(ss, best, _CMP_GT_OQ);
+        const __mmask8 faster = _mm512_mask_cmp_pd_mask(free, ss, best, _CMP_GT_OQ);
         best = _mm512_mask_blend_pd(faster, best, ss);
-        bestAt =
-            _mm512_mask_blend_epi64(faster, bestAt, _mm512_add_epi64(_mm512_set1_epi64(i), iota));
+        bestAt = _mm512_mask_blend_epi64(faster, bestAt, at);
+        at = _mm512_add_epi64(at, _mm512_set1_epi64(8));
     }
-    for (; i < end; ++i) guardVisit(g, i, p, s);
-    s.kinetic = laneSum(kinetic) + p.kinetic;
-    s.gravityPower = laneSum(gravityPower) + p.gravityPower;
-    s.boundaryPower = p.boundaryPower;
-    double speeds[8];
-    std::int64_t at[8];
-    _mm512_storeu_pd(speeds, best);
-    _mm512_storeu_si512(at, bestAt);
-    for (int l = 0; l < 8; ++l) {
-        const bool higher = speeds[l] > s.maxSpeedSquared;
-        const bool tie = speeds[l] == s.maxSpeedSquared && at[l] < s.fastest;
-        if (at[l] >= 0 && (higher || tie)) s.maxSpeedSquared = speeds[l], s.fastest = int(at[l]);
+    /// Particles [i, end) one by one into a chain of their own, then the totals.
+    [[gnu::target("avx2,avx512f")]] GuardSums finish(int i, int end) {
+        for (; i < end; ++i) guardVisit(g, i, p, s);
+        s.kinetic = laneSum(kinetic) + p.kinetic;
+        s.gravityPower = laneSum(gravityPower) + p.gravityPower;
+        s.boundaryPower = laneSum(boundaryPower) + p.boundaryPower;
+        double speeds[8];
+        std::int64_t lanes[8];
+        _mm512_storeu_pd(speeds, best);
+        _mm512_storeu_si512(lanes, bestAt);
+        for (int l = 0; l < 8; ++l) {
+            const bool higher = speeds[l] > s.maxSpeedSquared;
+            const bool tie = speeds[l] == s.maxSpeedSquared && lanes[l] < s.fastest;
+            if (lanes[l] >= 0 && (higher || tie))
+                s.maxSpeedSquared = speeds[l], s.fastest = int(lanes[l]);
+        }
+        return s;
     }
-    return s;
+};
+
+template <bool kOne, bool kGravity>
+[[gnu::target("avx2,avx512f")]] GuardSums guardOctetsAvx512(const GuardInput& g, int begin,
+                                                            int end) {
+    GuardOctetsAvx512<kOne, kGravity> chains(g, begin);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        __m512d vx, vy, vz;
+        loadRun8(g.v + 3 * std::size_t(i), vx, vy, vz);
+        if (allFree(g.constraint + i, 8))
+            chains.free(vx, vy, vz, i);
+        else
+            chains.mixed(vx, vy, vz, i);
+    }
+    return chains.finish(i, end);
+}
+
+GuardSums guardAvx512(const GuardInput& g, int begin, int end) {
+    const bool one = g.oneMass > 0.0;
+    if (g.hasGravity)
+        return one ? guardOctetsAvx512<true, true>(g, begin, end)
+                   : guardOctetsAvx512<false, true>(g, begin, end);
+    return one ? guardOctetsAvx512<true, false>(g, begin, end)
+               : guardOctetsAvx512<false, false>(g, begin, end);
+}
+
+// The kick and drift of a block and the guard's sums of it in one loop, at eight lanes
+// (kickGuardQuadsAvx2's): each octet's new velocities split into lanes from registers.
+template <bool kOne, bool kFloor, bool kGravity>
+[[gnu::target("avx2,avx512f")]] GuardSums kickGuardOctetsAvx512(const KickDrift& input,
+                                                                const GuardInput& g, int begin,
+                                                                int end, bool& belowFloor) {
+    KickOctetsAvx512<kOne, kFloor> kick(input);
+    GuardOctetsAvx512<kOne, kGravity> chains(g, begin);
+    int i = begin;
+    for (; i + 8 <= end; i += 8) {
+        __m512d vel[3], vx, vy, vz;
+        if (allFree(kick.k.constraint + i, 8)) {
+            kick.template octet<false>(i, vel);
+            splitRun8(vel[0], vel[1], vel[2], vx, vy, vz);
+            chains.free(vx, vy, vz, i);
+        } else {
+            kick.template octet<true>(i, vel);
+            splitRun8(vel[0], vel[1], vel[2], vx, vy, vz);
+            chains.mixed(vx, vy, vz, i);
+        }
+    }
+    bool below = false;
+    for (int q = i; q < end; ++q) below |= kickDriftOne(kick.k, q);
+    belowFloor = belowFloor || below || kick.below != 0;
+    return chains.finish(i, end);
+}
+
+/// loop.operator()<kOne, kFloor, kGravity>() for the kick's one mass and floor and the guard's
+/// gravity: the constants of kickGuardQuadsAvx2's and kickGuardOctetsAvx512's loops.
+template <class Loop>
+GuardSums withLoopConstants(const KickDrift& k, const GuardInput& g, Loop&& loop) {
+    const auto gravity = [&]<bool kOne, bool kFloor>() {
+        return g.hasGravity ? loop.template operator()<kOne, kFloor, true>()
+                            : loop.template operator()<kOne, kFloor, false>();
+    };
+    const auto floor = [&]<bool kOne>() {
+        return k.floor != -std::numeric_limits<double>::infinity()
+                   ? gravity.template operator()<kOne, true>()
+                   : gravity.template operator()<kOne, false>();
+    };
+    return k.oneMass > 0.0 ? floor.template operator()<true>() : floor.template operator()<false>();
 }
 
 // Eight at a time; NaN and inf are bad (not <= the largest double), a NaN lane keeps the max.
@@ -618,11 +759,14 @@ bool kickDrift(const KickDrift& k, int begin, int end) {
 GuardSums kickDriftSampled(const KickDrift& k, const GuardInput& g, int begin, int end,
                            bool& below) {
 #if defined(__x86_64__)
-    // One loop where both have four lanes, read the same velocities and agree on one mass.
-    if (simdWidth() == 4 && g.v == k.v && g.oneMass == k.oneMass) {
+    // One loop where both read the same velocities and agree on one mass.
+    if (simdWidth() >= 4 && g.v == k.v && g.oneMass == k.oneMass) {
         bool under = false;
-        const GuardSums s = k.oneMass > 0.0 ? kickGuardFloorAvx2<true>(k, g, begin, end, under)
-                                            : kickGuardFloorAvx2<false>(k, g, begin, end, under);
+        const bool wide = simdWidth() == 8;
+        const GuardSums s = withLoopConstants(k, g, [&]<bool kOne, bool kFloor, bool kGravity>() {
+            return wide ? kickGuardOctetsAvx512<kOne, kFloor, kGravity>(k, g, begin, end, under)
+                        : kickGuardQuadsAvx2<kOne, kFloor, kGravity>(k, g, begin, end, under);
+        });
         below = under && k.floor != -std::numeric_limits<double>::infinity();
         return s;
     }

@@ -175,7 +175,7 @@ double diffusionNsPerParticleStep(const rend::sim::Membrane& membrane, double se
     omp_set_num_threads(1);
     return fastestSpan(
         [&] {
-            diffusion.advance(theta, damage.bondAlive(), damage.version(), t, dt);
+            diffusion.advance(theta, damage, t, dt);
             t += dt;
         },
         membrane.particleCount(), seconds);

@@ -1,6 +1,7 @@
 #include "sim/DamageState.h"
 
 #include <algorithm>
+#include <cstring>
 #include <utility>
 
 #include "sim/TriangleEdges.h"
@@ -67,7 +68,14 @@ void DamageState::breakBond(int b) {
     bondAlive_[b] = 0;
     if (mirror_[b] >= 0) bondAlive_[mirror_[b]] = 0;
     ++brokenBonds_, ++version_;
+    breaks_.push_back({b, mirror_[b]});
     if (bondEdge_[b] >= 0) killEdge(bondEdge_[b]);
+}
+
+std::optional<std::span<const std::array<int, 2>>> DamageState::breaksSince(
+    std::uint64_t version) const {
+    if (version < logBase_ || version > version_) return std::nullopt;
+    return std::span<const std::array<int, 2>>(breaks_).subspan(version - logBase_);
 }
 
 void DamageState::breakEdge(int e) {
@@ -85,12 +93,21 @@ void DamageState::removeTriangle(int t) {
 
 void DamageState::weaken(int b, double gamma) { strength_[b] = gamma; }
 
+// Eight flags at a time where none is set (a byte at a time was 1% of a shipped foil's samples
+// at final quality, on every step that broke a bond).
 void DamageState::applyProposals() {
-    for (int b = 0; b < int(proposed_.size()); ++b)
+    const int n = int(proposed_.size());
+    for (int b = 0; b < n; ++b) {
+        std::uint64_t eight = 0;
+        if (b % 8 == 0 && b + 8 <= n && (std::memcpy(&eight, &proposed_[b], 8), eight == 0)) {
+            b += 7;
+            continue;
+        }
         if (proposed_[b]) {
             proposed_[b] = 0;
             breakBond(b);
         }
+    }
 }
 
 }  // namespace rend::sim

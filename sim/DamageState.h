@@ -19,6 +19,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -63,6 +64,10 @@ public:
     /// Moves on whenever bondAlive() changes (a break, a loaded state): a copy made at one
     /// version is current while it holds.
     std::uint64_t version() const { return version_; }
+    /// Both copies of each bond broken since `version`, in order, where every change since was a
+    /// break (a copy made then is brought up to date by clearing their flags alone); nullopt
+    /// where the state was loaded since, or `version` is not one it had.
+    std::optional<std::span<const std::array<int, 2>>> breaksSince(std::uint64_t version) const;
     std::size_t removedTriangleCount() const { return removedTriangles_; }
 
     // The operations.
@@ -88,7 +93,10 @@ public:
     static void visitState(Self& s, Archive& a) {
         a(s.bondAlive_), a(s.edgeAlive_), a(s.triangleAlive_), a(s.kept_), a(s.strength_);
         a(s.brokenBonds_), a(s.removedTriangles_);
-        if constexpr (!std::is_const_v<Self>) ++s.version_;  // loading
+        if constexpr (!std::is_const_v<Self>) {  // loading
+            ++s.version_;
+            s.breaks_.clear(), s.logBase_ = s.version_;
+        }
     }
 
 private:
@@ -101,6 +109,9 @@ private:
     std::vector<double> strength_;
     std::size_t brokenBonds_ = 0, removedTriangles_ = 0;
     std::uint64_t version_ = 0;
+    /// The breaks since version logBase_, one a version: version_ is logBase_ + their count.
+    std::vector<std::array<int, 2>> breaks_;
+    std::uint64_t logBase_ = 0;
 };
 
 }  // namespace rend::sim

@@ -163,11 +163,10 @@ std::vector<double> Diffusion::initialTheta() const {
     return theta;
 }
 
-double Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
-                       std::uint64_t aliveVersion, double t, double dt) {
+double Diffusion::step(std::vector<double>& theta, const DamageState& damage, double t, double dt) {
     const int n = int(theta.size());
     scratch_.resize(n);
-    tiles_.refresh(alive.data(), aliveVersion);
+    tiles_.refresh(damage);
     const int first = domain_ ? domain_->slab().begin : 0, last = domain_ ? domain_->slab().end : n;
     // The whole tiles of [first, last) eight at a time, the few particles at its ends alone.
     constexpr int kTile = DiffusionTiles::kTile, kChunk = 64;
@@ -210,14 +209,13 @@ double Diffusion::step(std::vector<double>& theta, std::span<const std::uint8_t>
     return change;
 }
 
-void Diffusion::advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
-                        std::uint64_t aliveVersion, double t, double dt) {
+void Diffusion::advance(std::vector<double>& theta, const DamageState& damage, double t,
+                        double dt) {
     // 0.9 of the Gershgorin bound keeps a margin for rounding.
     const int substeps = std::max(1, int(std::ceil(dt / (0.9 * stableDt_))));
     const double h = dt / substeps;
     lastChange_ = 0.0;
-    for (int k = 0; k < substeps; ++k)
-        lastChange_ += step(theta, alive, aliveVersion, t + k * h, h);
+    for (int k = 0; k < substeps; ++k) lastChange_ += step(theta, damage, t + k * h, h);
     // Each sum rounded up by far more than its rounding: a bound.
     lastChange_ *= 1.0 + 0x1p-30;
 }

@@ -50,11 +50,9 @@ public:
     /// theta at t = 0 (initial value, edges applied).
     std::vector<double> initialTheta() const;
 
-    /// Advances theta from t to t + dt, sub-stepping as the stability bound requires.
-    /// `alive` per directed bond of the bonds it was built on; `aliveVersion` changes whenever
-    /// it does (DamageState::version()).
-    void advance(std::vector<double>& theta, std::span<const std::uint8_t> alive,
-                 std::uint64_t aliveVersion, double t, double dt);
+    /// Advances theta from t to t + dt, sub-stepping as the stability bound requires, through
+    /// the bonds `damage` (of the bonds it was built on) keeps alive.
+    void advance(std::vector<double>& theta, const DamageState& damage, double t, double dt);
 
     /// At least every |theta change| of the last advance() (0 before the first), where
     /// measureChanges() asked for it; else -1.
@@ -87,8 +85,7 @@ private:
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
     /// One sub-step; returns at least every |theta change| in it where measure_, else 0.
-    double step(std::vector<double>& theta, std::span<const std::uint8_t> alive,
-                std::uint64_t aliveVersion, double t, double dt);
+    double step(std::vector<double>& theta, const DamageState& damage, double t, double dt);
 
     double K_ = 0.0;
     double stableDt_ = 0.0;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/Bonds.h"
+#include "sim/DamageState.h"
 
 namespace rend::sim {
 
@@ -42,6 +43,10 @@ struct DiffusionTiles {
     static DiffusionTiles build(const BondFamilies& bonds, const std::vector<double>& rate);
     /// Copies `alive` (per directed bond) into `livingRows` when `version` has moved.
     void refresh(const std::uint8_t* alive, std::uint64_t version);
+    /// The same from `damage`: where only breaks happened since livingVersion, their slots'
+    /// bits alone (DamageState::breaksSince).
+    void refresh(const DamageState& damage);
+    std::vector<int> offsets;  ///< the bonds' BondFamilies::offsets (a bond's particle)
     /// Whether slot u's bond lives (as of refresh()).
     bool living(int u) const { return (livingRows[u / kTile] >> (u % kTile)) & 1u; }
     /// How many rows are runs, and how many have a class (exact or stepped).

@@ -531,7 +531,7 @@ void Membrane::step() {
         forcesCurrent_ = false;
     }
     if (diffusion_) {
-        diffusion_->advance(theta_, damageState_.bondAlive(), damageState_.version(), time_,
+        diffusion_->advance(theta_, damageState_, time_,
                             dt_);  // theta^n -> theta^n+1 (and its ghosts, decomposed)
         forcesCurrent_ = false;
     }

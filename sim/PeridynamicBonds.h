@@ -219,6 +219,11 @@ private:
     mutable std::vector<std::uint8_t> livingTiles_;
     mutable std::uint64_t livingTilesVersion_ = ~std::uint64_t(0);
     const std::uint8_t* livingTiles() const;
+    /// Calls brokenBond(i, j) for the ends of each bond broken since `version` and answers
+    /// true, or answers false where that is not known (DamageState::breaksSince): a copy of the
+    /// flags made then is brought up to date by those bonds alone.
+    template <class Each>
+    bool forBreaksSince(std::uint64_t version, Each&& brokenBond) const;
     std::vector<double> yieldFactor_;      ///< per bond, eta0 over the law's (maps); empty: all 1
     std::vector<double> softeningFactor_;  ///< per bond, beta over the law's (maps); empty: all 1
     std::vector<double> ratioFactor_;      ///< per bond, c*/c over the law's (maps); empty: all 1

@@ -8,11 +8,13 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "sim/DamageState.h"
 #include "sim/Lattice.h"
 #include "sim/Random.h"
+#include "sim/StateArchive.h"
 
 namespace rend::sim {
 namespace {
@@ -111,6 +113,52 @@ TEST(BondFamilies, ABrokenBondsCopyAtTheOtherEndBreaksWithIt) {
     DamageState damage(bonds, lattice.triangles);
     damage.breakBond(orphaned);
     EXPECT_EQ(std::count(damage.bondAlive().begin(), damage.bondAlive().end(), 0), 1);
+}
+
+// Proposed breaks applied at once (eight flags at a time where none is set) give the bits and
+// the order of breaking them one by one in index order; DamageState::breaksSince gives both
+// copies of each bond broken since a version, and nothing once the state was loaded since.
+TEST(DamageState, AppliedProposalsBreakInIndexOrderAndTheLogGivesEachBreak) {
+    SheetParams sheet;
+    sheet.size = {0.1, 0.08};
+    sheet.dx = 0.01;
+    const Lattice lattice = generateLattice(sheet);
+    const BondFamilies bonds = buildBondFamilies(lattice.positions, 1.5 * sheet.dx);
+    const int n = int(bonds.directedCount());
+    DamageState proposed(bonds, lattice.triangles), oneByOne(bonds, lattice.triangles);
+    // Ends, a word's every flag, neighbours across a word's edge and a scatter.
+    std::vector<int> chosen = {0, 7, 8, 9, 15, 16, 17, 18, 19, 20, 21, 22, 23, n - 1};
+    for (int b = 30; b < n - 1; b += 13) chosen.push_back(b);
+    const std::uint64_t before = proposed.version();
+    for (const int b : chosen) proposed.proposeBreak(b);
+    proposed.applyProposals();
+    std::sort(chosen.begin(), chosen.end());
+    for (const int b : chosen) oneByOne.breakBond(b);
+    EXPECT_EQ(proposed.bondAlive(), oneByOne.bondAlive());
+    EXPECT_EQ(proposed.keptTriangles(), oneByOne.keptTriangles());
+    EXPECT_EQ(proposed.brokenBondCount(), oneByOne.brokenBondCount());
+    for (int b = 0; b < n; ++b) ASSERT_EQ(proposed.proposals()[b], 0) << b;
+    const auto log = proposed.breaksSince(before);
+    ASSERT_TRUE(log.has_value());
+    ASSERT_EQ(log->size(), proposed.brokenBondCount());
+    std::vector<std::uint8_t> alive(n, 1);
+    for (const auto& [b, mirror] : *log) {
+        ASSERT_EQ(mirror, proposed.mirror(b));
+        EXPECT_TRUE(alive[b]) << "bond " << b << " broken twice";
+        alive[b] = 0;
+        if (mirror >= 0) alive[mirror] = 0;
+    }
+    EXPECT_EQ(alive, proposed.bondAlive());
+    EXPECT_EQ(proposed.breaksSince(proposed.version())->size(), 0u);
+    EXPECT_FALSE(proposed.breaksSince(proposed.version() + 1).has_value());
+    // A loaded state's copy of the flags must be made again.
+    StateWriter out;
+    DamageState::visitState(std::as_const(proposed), out);
+    const std::vector<std::byte> bytes = out.take();
+    StateReader in(bytes);
+    DamageState::visitState(oneByOne, in);
+    EXPECT_FALSE(oneByOne.breaksSince(before).has_value());
+    EXPECT_TRUE(oneByOne.breaksSince(oneByOne.version()).has_value());
 }
 
 }  // namespace

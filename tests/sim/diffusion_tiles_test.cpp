@@ -215,14 +215,14 @@ TEST(DiffusionTiles, FollowTheBondsAsTheyBreak) {
     for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(3, i);
     const double dt = 0.5 * early.stableTimeStep();
     std::vector<double> a = theta;
-    early.advance(a, damage.bondAlive(), damage.version(), 0.0, dt);
+    early.advance(a, damage, 0.0, dt);
     EXPECT_NE(a, theta);
     for (const double value : a) ASSERT_TRUE(std::isfinite(value));
     for (int b = 0; b < int(sheet.bonds.directedCount()); b += 7) damage.breakBond(b);
     Diffusion late(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
     std::vector<double> b = a;
-    early.advance(a, damage.bondAlive(), damage.version(), dt, dt);
-    late.advance(b, damage.bondAlive(), damage.version(), dt, dt);
+    early.advance(a, damage, dt, dt);
+    late.advance(b, damage, dt, dt);
     EXPECT_EQ(a, b);
 }
 
@@ -244,7 +244,7 @@ TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
     for (const double steps : {0.5, 2.5}) {  // one sub-step, then three
         const double dt = steps * diffusion.stableTimeStep();
         const std::vector<double> before = theta;
-        diffusion.advance(theta, damage.bondAlive(), damage.version(), 0.0, dt);
+        diffusion.advance(theta, damage, 0.0, dt);
         double largest = 0.0;
         for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(theta[i] - before[i]));
         EXPECT_GE(diffusion.lastChange(), largest) << steps;
@@ -255,7 +255,7 @@ TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
     Diffusion held(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
     held.measureChanges();
     const std::vector<double> before = theta;
-    held.advance(theta, damage.bondAlive(), damage.version(), 0.0, 0.5 * held.stableTimeStep());
+    held.advance(theta, damage, 0.0, 0.5 * held.stableTimeStep());
     double largest = 0.0;
     for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(theta[i] - before[i]));
     EXPECT_GT(largest, 40.0);

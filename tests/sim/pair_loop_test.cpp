@@ -378,6 +378,63 @@ TEST(PairLoop, TheLookAheadSlackBoundsEveryPairsRelativeVelocity) {
     EXPECT_GT(lookAheadSlack(0.0, 1e-4), 0.0);
 }
 
+/// Counts the particles a pass asks it to move, and moves none.
+struct CountingMotion final : BlockMotion {
+    int moved = 0;
+    void move(int begin, int end, const double*, int) override { moved += end - begin; }
+};
+
+// The power law's pass moves the particles (StepState::motion) only where the last pass's gap
+// to the look-ahead's reach outlasts what moved since and this step's own slack
+// (PeridynamicBonds::lookAheadClear): the largest speed bound at which it moves them halves
+// where a drift as long as the step came before, falls further with theta's change times the
+// expansion, and nothing moves where the drift, the speeds or theta's change are unknown, or
+// the stiffening asked for is not the last pass's.
+TEST(PairLoop, ThePowerLawsPassMovesOnlyWhereItsLastGapOutlastsTheMotionSince) {
+    MembraneParams params = SmallSheet::params(BondLawKind::PowerLaw);
+    params.material.expansion = 0.5;
+    SmallSheet sheet(params);
+    std::vector<Eigen::Vector3d> x = sheet.lattice.positions;
+    for (Eigen::Vector3d& p : x) p *= 0.99;  // every bond compressed by 1%
+    const std::vector<Eigen::Vector3d> v(x.size(), Eigen::Vector3d::Zero());
+    const std::vector<double> theta(x.size(), 0.0);
+    const double dt = 1e-4, needed = 50.0;
+    const auto work = sheet.solver.makeWorkspace();
+    std::vector<Eigen::Vector3d> force;
+    const auto pass = [&](double speed, StepState::SinceLastPass since, double asked) {
+        CountingMotion motion;
+        StepState s{x, v, theta, dt};
+        s.stiffeningNeeded = asked, s.speedBound = speed, s.sinceLastPass = since;
+        s.motion = &motion;
+        sheet.solver.advance(s, *work, force);
+        EXPECT_EQ(sheet.solver.stiffening(), asked) << "nothing stiffens";
+        EXPECT_TRUE(motion.moved == 0 || motion.moved == int(x.size()));
+        return motion.moved > 0;
+    };
+    pass(-1.0, {}, needed);  // the first pass: its gap only
+    // The largest speed bound (to 1e-9) at which the pass moves them.
+    const auto largest = [&](StepState::SinceLastPass since) {
+        double low = 0.0, high = 1e6;
+        for (int k = 0; k < 80 && high - low > 1e-9 * high; ++k) {
+            const double mid = 0.5 * (low + high);
+            (pass(mid, since, needed) ? low : high) = mid;
+        }
+        return low;
+    };
+    const double still = largest({0.0, 0.0, 1.0}), drifted = largest({dt, 0.0, 1.0});
+    ASSERT_GT(still, 1.0) << "a sheet compressed by 1% lies far from the reach of 50";
+    EXPECT_NEAR(drifted, 0.5 * still, 1e-4 * still);
+    const double swollen = largest({dt, 0.2, 1.0});
+    EXPECT_LT(swollen, 0.95 * drifted);
+    EXPECT_GT(swollen, 0.0);
+    EXPECT_EQ(largest({dt, 1e3, 1.0}), 0.0) << "theta's change alone closes the gap";
+    EXPECT_FALSE(pass(0.0, {-1.0, 0.0, 1.0}, needed)) << "the drift unknown";
+    EXPECT_FALSE(pass(-1.0, {0.0, 0.0, 1.0}, needed)) << "the speeds unknown";
+    EXPECT_FALSE(pass(0.0, {0.0, -1.0, 1.0}, needed)) << "theta's change unknown";
+    pass(0.0, {0.0, 0.0, 1.0}, needed);
+    EXPECT_FALSE(pass(0.0, {0.0, 0.0, 1.0}, 2.0 * needed)) << "another stiffening asked for";
+}
+
 // largestChange: the largest |after - before| of n values at every width and length (the lanes
 // and the rest).
 TEST(PairLoop, TheLargestChangeIsTheLargestDifference) {

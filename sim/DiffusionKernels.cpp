@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 
+#include "sim/PairSums.h"
 #include "sim/RowSteps.h"
 #include "sim/StepKernels.h"
 
@@ -181,39 +182,73 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
                          _mm512_mul_pd(steps, _mm512_set1_pd(d.classUnit[k])));
 }
 
+/// A plain tile (DiffusionTiles::plainTile) of kRows rows (6, 8 or 12; 0: `count` rows) eight
+/// lanes wide: its rows' runs as plain loads, each row's rate from its class and its lanes'
+/// life flags as the add's mask; the same terms in the same order as the loop below.
+template <int kRows>
+[[gnu::target("avx2,avx512f")]] inline void diffusePlainTileAvx512(const DiffusionTiles& d,
+                                                                   const double* theta,
+                                                                   double* next, __m512d step,
+                                                                   int t, bool stream,
+                                                                   int count = kRows) {
+    const int first = d.tileBegin[t] / 8;
+    const int* __restrict run = d.rowRun.data() + first;
+    const int* __restrict rowClass = d.rowClass.data() + first;
+    const std::uint8_t* __restrict living = d.livingRows.data() + first;
+    const double* __restrict classRate = d.classRate.data();
+    const __m512d own = _mm512_loadu_pd(theta + 8 * t);
+    __m512d flux = _mm512_setzero_pd();
+    std::uint64_t lives = 0;  // eight rows' living bytes as one word
+    if constexpr (kRows == 8) std::memcpy(&lives, living, sizeof lives);
+#pragma GCC unroll 12
+    for (int k = 0; k < (kRows > 0 ? kRows : count); ++k) {
+        const __m512d term = _mm512_mul_pd(_mm512_set1_pd(classRate[rowClass[k]]),
+                                           _mm512_sub_pd(_mm512_loadu_pd(theta + run[k]), own));
+        const unsigned on = kRows == 8 ? unsigned(lives >> (8 * k)) : living[k];
+        flux = _mm512_mask_add_pd(flux, __mmask8(on), flux, term);
+    }
+    const __m512d after = _mm512_add_pd(own, _mm512_mul_pd(step, flux));
+    if (stream)
+        _mm512_stream_pd(next + 8 * t, after);
+    else
+        _mm512_storeu_pd(next + 8 * t, after);
+}
+
 [[gnu::target("avx2,avx512f")]] void diffuseTilesAvx512(const DiffusionTiles& d,
                                                         const double* theta, double* next,
-                                                        double dt, int firstTile, int lastTile) {
+                                                        double dt, int firstTile, int lastTile,
+                                                        bool around) {
     const int* __restrict begin = d.tileBegin.data();
     const int* __restrict partner = d.partner.data();
     const int* __restrict run = d.rowRun.data();
     const std::uint8_t* __restrict living = d.livingRows.data();
-    const int* __restrict rowClass = d.rowClass.data();
-    const double* __restrict classRate = d.classRate.data();
     const std::uint8_t* __restrict plain = d.plainTile.data();
     const __m512d step = _mm512_set1_pd(dt);
+    const bool stream = around && (std::uintptr_t(next) & 63) == 0;
     for (int t = firstTile; t < lastTile; ++t) {
+        // Six rows are the hexagonal sheets' (every shipped scene's), eight the square's, twelve
+        // a square sheet's of horizon 2.2. Only eight had a path of their own here before; the
+        // others went by the loop below, testing each row's run and class (crack_path_sources on
+        // its hexagonal lattice at 10^4, alternate spans: linear 6.51 / 6.51 -> 6.33 / 6.34 ns
+        // per particle-step, elastoplastic 8.43 / 8.27 -> 8.09 / 8.22, the same bits).
+        switch (plain[t]) {
+            case 6:
+                diffusePlainTileAvx512<6>(d, theta, next, step, t, stream);
+                continue;
+            case 8:
+                diffusePlainTileAvx512<8>(d, theta, next, step, t, stream);
+                continue;
+            case 12:
+                diffusePlainTileAvx512<12>(d, theta, next, step, t, stream);
+                continue;
+            case 0:
+                break;
+            default:
+                diffusePlainTileAvx512<0>(d, theta, next, step, t, stream, plain[t]);
+                continue;
+        }
         const __m512d own = _mm512_loadu_pd(theta + 8 * t);
         __m512d flux = _mm512_setzero_pd();
-        if (plain[t] == 8) {
-            // The loop below's terms for a tile of eight runs with one rate each: unrolled, its
-            // rows' tests left out and their living bytes read as one word (the diffusion alone,
-            // crack_path_sources, linear, pinned: 1.26 -> 0.93 ns per particle-step at 10^4,
-            // 1.39 -> 1.11 at 10^6).
-            const int first = begin[t] / 8;
-            std::uint64_t lives;  // the eight rows' living bytes
-            std::memcpy(&lives, living + first, sizeof lives);
-#pragma GCC unroll 8
-            for (int k = 0; k < 8; ++k) {
-                const int row = first + k;
-                const __m512d term =
-                    _mm512_mul_pd(_mm512_set1_pd(classRate[rowClass[row]]),
-                                  _mm512_sub_pd(_mm512_loadu_pd(theta + run[row]), own));
-                flux = _mm512_mask_add_pd(flux, __mmask8(lives >> (8 * k)), flux, term);
-            }
-            _mm512_storeu_pd(next + 8 * t, _mm512_add_pd(own, _mm512_mul_pd(step, flux)));
-            continue;
-        }
         for (int row = begin[t] / 8; row < begin[t + 1] / 8; ++row) {
             const __m512d other =
                 run[row] >= 0
@@ -226,6 +261,7 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
         }
         _mm512_storeu_pd(next + 8 * t, _mm512_add_pd(own, _mm512_mul_pd(step, flux)));
     }
+    if (stream) _mm_sfence();
 }
 
 /// Whether the kRows (6, 8 or 12) bytes from `rows` are all 0xff: read as whole words each
@@ -397,10 +433,16 @@ template <int kRows>
 
 }  // namespace
 
+// Past the caches, the new theta is written around them: a store that first reads its line
+// read 8 bytes a particle for nothing (crack_path_sources at 10^7 particles, linear, alternate
+// spans of one run: 10.54 -> 10.50 and 10.84 -> 10.69 ns per particle-step).
 void diffuseTiles(const DiffusionTiles& tiles, const double* theta, double* next, double dt,
-                  int firstTile, int lastTile) {
+                  int firstTile, int lastTile, std::optional<bool> around) {
 #if defined(__x86_64__)
-    if (simdWidth() == 8) return diffuseTilesAvx512(tiles, theta, next, dt, firstTile, lastTile);
+    if (simdWidth() == 8)
+        return diffuseTilesAvx512(
+            tiles, theta, next, dt, firstTile, lastTile,
+            around.value_or(streamsForces(8LL * (std::ssize(tiles.tileBegin) - 1))));
     if (simdWidth() == 4) return diffuseTilesAvx2(tiles, theta, next, dt, firstTile, lastTile);
 #endif
     for (int t = firstTile; t < lastTile; ++t) diffuseTile(tiles, theta, next, dt, t);

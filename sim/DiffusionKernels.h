@@ -6,6 +6,7 @@
 // loop (Diffusion::step), skipping the dead bonds and the pads by a mask: the same bits.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "sim/Bonds.h"
@@ -62,8 +63,10 @@ void diffuseParticle(const DiffusionTiles& tiles, const double* theta, double* n
                      int i);
 
 /// next[i] = theta[i] + dt sum over living bonds of rate (theta_j - theta_i), for the particles
-/// of tiles [firstTile, lastTile) (all eight of each).
+/// of tiles [firstTile, lastTile) (all eight of each). With `around`, the eight-lane sums of
+/// the plain tiles store around the caches where next lies on 64-byte lines (the same values);
+/// by default, where the sheet is larger than the caches (sim/PairSums.h's streamsForces()).
 void diffuseTiles(const DiffusionTiles& tiles, const double* theta, double* next, double dt,
-                  int firstTile, int lastTile);
+                  int firstTile, int lastTile, std::optional<bool> around = std::nullopt);
 
 }  // namespace rend::sim

@@ -145,8 +145,9 @@ INSTANTIATE_TEST_SUITE_P(
 // A regular sheet's own rates (one exact value per direction) make most tiles plain: a run with
 // one rate per row, summed as straight code with the rows' living bytes read as words; six rows
 // on a hexagonal sheet, eight on a square one, twelve on a square one of horizon 2.2 (and 28 and
-// 36 at horizon 3, by a loop). With some
-// bonds dead, and tiles with all of them living, the sums keep the loop's bits.
+// 36 at horizon 3, by a loop), at every width (the AVX-512 sums took only the eight rows' as
+// plain code before 2026-11-30). With some bonds dead, and tiles with all of them living, the
+// sums keep the loop's bits, stored through the caches or around them.
 struct PlainCase {
     LatticeKind lattice;
     double horizon;
@@ -176,12 +177,16 @@ TEST_P(DiffusionTilesPlain, SumAsTheLoopDoes) {
     for (int i = 0; i < n; ++i) theta[i] = 40.0 * (uniformFromHash(5, i) - 0.5);
     const double dt = 1e-3;
     const int whole = n / kTile;
-    std::vector<double> next(n, -1.0);
-    diffuseTiles(tiles, theta.data(), next.data(), dt, 0, whole);
-    for (int i = kTile * whole; i < n; ++i)
-        diffuseParticle(tiles, theta.data(), next.data(), dt, i);
     const std::vector<double> expected = naiveStep(bonds, rate, alive, theta, dt);
-    EXPECT_EQ(std::memcmp(next.data(), expected.data(), n * sizeof(double)), 0);
+    // Stored through the caches and around them (as past the caches: the same values), into
+    // 64-byte lines (a vector's heap block need not start on one).
+    for (const bool around : {false, true}) {
+        std::vector<double> buffer(n + 8, -1.0);
+        double* next = buffer.data() + (8 - (std::uintptr_t(buffer.data()) / 8) % 8) % 8;
+        diffuseTiles(tiles, theta.data(), next, dt, 0, whole, around);
+        for (int i = kTile * whole; i < n; ++i) diffuseParticle(tiles, theta.data(), next, dt, i);
+        EXPECT_EQ(std::memcmp(next, expected.data(), n * sizeof(double)), 0) << around;
+    }
     int plain = 0, plainWithDead = 0;
     for (int t = 0; t < whole; ++t) {
         if (tiles.plainTile[t] != c.rows) continue;  // a square sheet's edges: 8 of 12 too

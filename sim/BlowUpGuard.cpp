@@ -156,7 +156,8 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
                        motion_[b].gravityPower, motion_[b].maxSpeedSquared,
                        motion_[b].maxAbsTheta,  motion_[b].fastest,
                        motion_[b].firstBad};
-        if (!s.theta.empty()) addThetaSums(sums, guardThetaSums(s.theta.data(), begin, end));
+        if (!s.theta.empty() && !s.thetaSums)
+            addThetaSums(sums, guardThetaSums(s.theta.data(), begin, end));
         blocks_[b] = sampleOf(sums);
     });
     Sample total;
@@ -170,6 +171,13 @@ BlowUpGuard::Sample BlowUpGuard::sample(const State& s) const {
             total.fastest = b.fastest;
         }
         if (total.firstBad < 0) total.firstBad = b.firstBad;
+    }
+    // The largest |theta| and the lowest bad index over all blocks, as the blocks' own sums
+    // would have joined them.
+    if (sampled && !s.theta.empty() && s.thetaSums) {
+        total.maxAbsTheta = std::max(total.maxAbsTheta, s.thetaSums->maxAbsTheta);
+        const int bad = s.thetaSums->firstBad;
+        if (bad >= 0 && (total.firstBad < 0 || bad < total.firstBad)) total.firstBad = bad;
     }
     if (s.domain) reduce(*s.domain, total);
     return total;

@@ -74,6 +74,10 @@ public:
         /// over all of them, so every process decides alike.
         Domain* domain = nullptr;
         double oneMass = 0.0;  ///< > 0: every particle's mass (sim/StepKernels.h's GuardInput)
+        /// theta's half of the sample (guardThetaSums over the particles sampled), where the
+        /// diffusion took it as it wrote theta (Diffusion::thetaSums): theta is then not read
+        /// again for it. Null: read.
+        const GuardSums* thetaSums = nullptr;
     };
     /// Checks the state after a step; throws NumericalBlowUp naming the step, the fastest (or
     /// first non-finite) particle and a suggested dt. `totalEnergy` (kinetic + strain) is

@@ -163,26 +163,29 @@ std::vector<double> Diffusion::initialTheta() const {
     return theta;
 }
 
-double Diffusion::step(std::vector<double>& theta, const DamageState& damage, double t, double dt) {
+double Diffusion::step(std::vector<double>& theta, const DamageState& damage, double t, double dt,
+                       bool takeSums) {
     const int n = int(theta.size());
     scratch_.resize(n);
     tiles_.refresh(damage);
     const int first = domain_ ? domain_->slab().begin : 0, last = domain_ ? domain_->slab().end : n;
     // The whole tiles of [first, last) eight at a time, the few particles at its ends alone.
-    constexpr int kTile = DiffusionTiles::kTile, kChunk = 64;
+    constexpr int kTile = DiffusionTiles::kTile;
     const int firstTile = (first + kTile - 1) / kTile, lastTile = std::max(firstTile, last / kTile);
     const int chunks = (lastTile - firstTile + kChunk - 1) / kChunk;
     const double* now = theta.data();
     double* next = scratch_.data();
-    // The largest change of each chunk, read back while it is in cache (lastChange()).
+    // The largest change of each chunk (lastChange()) and the guard's sums of its new theta
+    // (thetaSums()), read back while it is in cache.
     chunkChange_.assign(measure_ ? std::max(chunks, 0) : 0, 0.0);
+    chunkSums_.assign(takeSums ? std::max(chunks, 0) : 0, GuardSums{});
     forEachIndex(n >= kParallelThreshold, 0, chunks, [&](int c) {
         const int begin = firstTile + c * kChunk, end = std::min(lastTile, begin + kChunk);
-        diffuseTiles(tiles_, now, next, dt, begin, end);
-        if (measure_)
-            chunkChange_[c] =
-                largestChange(now + kTile * std::size_t(begin), next + kTile * std::size_t(begin),
-                              kTile * std::size_t(end - begin));
+        if (!measure_ && !takeSums) return diffuseTiles(tiles_, now, next, dt, begin, end);
+        DiffusionMeasures taken;
+        diffuseTiles(tiles_, now, next, dt, begin, end, std::nullopt, &taken);
+        if (measure_) chunkChange_[c] = taken.largestChange;
+        if (takeSums) chunkSums_[c] = taken.theta;
     });
     double change = 0.0;
     for (const double c : chunkChange_) change = std::max(change, c);
@@ -196,17 +199,41 @@ double Diffusion::step(std::vector<double>& theta, const DamageState& damage, do
         change =
             std::max(change, largestChange(now + tailBegin, next + tailBegin, last - tailBegin));
     theta.swap(scratch_);
+    // The chunks whose particles the sources set or moved after their sums were taken.
+    std::vector<std::uint8_t> touched(chunkSums_.size(), 0);
+    const auto touch = [&](int i) {
+        const int tile = i / kTile;
+        if (takeSums && tile >= firstTile && tile < lastTile)
+            touched[(tile - firstTile) / kChunk] = 1;
+    };
     for (const Spot& spot : spots_)  // serial, in a fixed order: identical for any thread count
         if (t >= spot.start && t < spot.end) {
-            for (int i : spot.particles) theta[i] += dt * spot.rate;
+            for (int i : spot.particles) theta[i] += dt * spot.rate, touch(i);
             change += std::fabs(dt * spot.rate);
         }
     for (const auto& [i, value] : held_) {
-        theta[i] = value;
+        theta[i] = value, touch(i);
         change = std::max(change, std::fabs(value - scratch_[i]));
     }
+    if (takeSums)
+        takeThetaSums(theta, touched, firstTile, lastTile, first, headEnd, tailBegin, last);
     if (domain_) domain_->exchange(theta.data(), 1);
     return change;
+}
+
+void Diffusion::takeThetaSums(const std::vector<double>& theta,
+                              const std::vector<std::uint8_t>& touched, int firstTile, int lastTile,
+                              int first, int headEnd, int tailBegin, int last) {
+    constexpr int kTile = DiffusionTiles::kTile;
+    GuardSums sums;
+    for (std::size_t c = 0; c < chunkSums_.size(); ++c) {
+        const int begin = firstTile + int(c) * kChunk, end = std::min(lastTile, begin + kChunk);
+        addThetaSums(sums, touched[c] ? guardThetaSums(theta.data(), kTile * begin, kTile * end)
+                                      : chunkSums_[c]);
+    }
+    if (first < headEnd) addThetaSums(sums, guardThetaSums(theta.data(), first, headEnd));
+    if (tailBegin < last) addThetaSums(sums, guardThetaSums(theta.data(), tailBegin, last));
+    thetaSums_ = sums, thetaSumsTaken_ = true;
 }
 
 void Diffusion::advance(std::vector<double>& theta, const DamageState& damage, double t,
@@ -215,7 +242,8 @@ void Diffusion::advance(std::vector<double>& theta, const DamageState& damage, d
     const int substeps = std::max(1, int(std::ceil(dt / (0.9 * stableDt_))));
     const double h = dt / substeps;
     lastChange_ = 0.0;
-    for (int k = 0; k < substeps; ++k) lastChange_ += step(theta, damage, t + k * h, h);
+    for (int k = 0; k < substeps; ++k)
+        lastChange_ += step(theta, damage, t + k * h, h, k + 1 == substeps);
     // Each sum rounded up by far more than its rounding: a bound.
     lastChange_ *= 1.0 + 0x1p-30;
 }

@@ -22,6 +22,7 @@
 #include "sim/Domain.h"
 #include "sim/Lattice.h"
 #include "sim/Params.h"
+#include "sim/StepKernels.h"
 
 namespace rend::sim {
 
@@ -61,6 +62,11 @@ public:
     /// power law's look-ahead reads it, PeridynamicBonds::lookAheadClear).
     void measureChanges() { measure_ = true; }
 
+    /// The blow-up guard's theta half (sim/StepKernels.h's guardThetaSums: the largest |theta|
+    /// and the lowest index whose theta is not finite) of the theta the last advance() left,
+    /// over the particles it advanced, taken as it wrote them; null before the first.
+    const GuardSums* thetaSums() const { return thetaSumsTaken_ ? &thetaSums_ : nullptr; }
+
     std::size_t spotCount() const { return spots_.size(); }
     /// The bonds' rates in tiles (sim/DiffusionKernels.h).
     const DiffusionTiles& tiles() const { return tiles_; }
@@ -84,8 +90,16 @@ private:
     };
     void addSpot(const DiffusionSpot& spot, const SourceFrame& frame);
     void expandScatter(const SpotScatter& scatter, const SourceFrame& frame);
-    /// One sub-step; returns at least every |theta change| in it where measure_, else 0.
-    double step(std::vector<double>& theta, const DamageState& damage, double t, double dt);
+    /// One sub-step; returns at least every |theta change| in it where measure_, else 0. With
+    /// `takeSums` (the last sub-step), takes thetaSums() of the theta it leaves.
+    double step(std::vector<double>& theta, const DamageState& damage, double t, double dt,
+                bool takeSums);
+    /// thetaSums() from each chunk's sums of the values step() wrote, the `touched` ones (whose
+    /// particles a source set or moved since) summed again from `theta`, and the particles
+    /// [first, headEnd) and [tailBegin, last) outside the chunks.
+    void takeThetaSums(const std::vector<double>& theta, const std::vector<std::uint8_t>& touched,
+                       int firstTile, int lastTile, int first, int headEnd, int tailBegin,
+                       int last);
 
     double K_ = 0.0;
     double stableDt_ = 0.0;
@@ -97,7 +111,11 @@ private:
     std::vector<Spot> spots_;
     std::vector<std::pair<int, double>> held_;  ///< edge sources: particle, value
     std::vector<double> scratch_;
-    std::vector<double> chunkChange_;  ///< step()'s largest change per chunk of tiles
+    static constexpr int kChunk = 64;   ///< tiles per chunk of step()'s loop
+    std::vector<double> chunkChange_;   ///< step()'s largest change per chunk of tiles
+    std::vector<GuardSums> chunkSums_;  ///< step()'s thetaSums() per chunk of tiles
+    GuardSums thetaSums_;
+    bool thetaSumsTaken_ = false;
     double lastChange_ = 0.0;
     bool measure_ = false;
     Domain* domain_ = nullptr;

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <optional>
 
+#include "sim/PairKernels.h"
 #include "sim/PairSums.h"
 #include "sim/RowSteps.h"
 #include "sim/StepKernels.h"
@@ -186,17 +188,15 @@ void diffuseTile(const DiffusionTiles& d, const double* theta, double* next, dou
 /// lanes wide: its rows' runs as plain loads, each row's rate from its class and its lanes'
 /// life flags as the add's mask; the same terms in the same order as the loop below.
 template <int kRows>
-[[gnu::target("avx2,avx512f")]] inline void diffusePlainTileAvx512(const DiffusionTiles& d,
-                                                                   const double* theta,
-                                                                   double* next, __m512d step,
-                                                                   int t, bool stream,
-                                                                   int count = kRows) {
+[[gnu::target("avx2,avx512f")]] inline __m512d plainTileAvx512(const DiffusionTiles& d,
+                                                               const double* theta, __m512d own,
+                                                               __m512d step, int t,
+                                                               int count = kRows) {
     const int first = d.tileBegin[t] / 8;
     const int* __restrict run = d.rowRun.data() + first;
     const int* __restrict rowClass = d.rowClass.data() + first;
     const std::uint8_t* __restrict living = d.livingRows.data() + first;
     const double* __restrict classRate = d.classRate.data();
-    const __m512d own = _mm512_loadu_pd(theta + 8 * t);
     __m512d flux = _mm512_setzero_pd();
     std::uint64_t lives = 0;  // eight rows' living bytes as one word
     if constexpr (kRows == 8) std::memcpy(&lives, living, sizeof lives);
@@ -207,61 +207,100 @@ template <int kRows>
         const unsigned on = kRows == 8 ? unsigned(lives >> (8 * k)) : living[k];
         flux = _mm512_mask_add_pd(flux, __mmask8(on), flux, term);
     }
-    const __m512d after = _mm512_add_pd(own, _mm512_mul_pd(step, flux));
-    if (stream)
-        _mm512_stream_pd(next + 8 * t, after);
-    else
-        _mm512_storeu_pd(next + 8 * t, after);
+    return _mm512_add_pd(own, _mm512_mul_pd(step, flux));
 }
 
+/// DiffusionMeasures taken eight lanes at a time from the values stored, tile after tile, with
+/// largestChange's and guardThetaAvx512's operations on the same lanes in the same order: the
+/// same values.
+struct MeasuresAvx512 {
+    __m512d change, largest;
+    int firstBad = -1;
+    [[gnu::target("avx2,avx512f")]] MeasuresAvx512()
+        : change(_mm512_setzero_pd()), largest(_mm512_setzero_pd()) {}
+    [[gnu::always_inline, gnu::target("avx2,avx512f")]] void add(__m512d own, __m512d after,
+                                                                 int t) {
+        const __m512d d = _mm512_sub_pd(after, own);
+        change = _mm512_max_pd(change, _mm512_max_pd(d, _mm512_sub_pd(_mm512_setzero_pd(), d)));
+        const __m512d a = _mm512_abs_pd(after);
+        const unsigned bad =
+            _mm512_cmp_pd_mask(a, _mm512_set1_pd(std::numeric_limits<double>::max()), _CMP_NLE_UQ);
+        if (bad != 0 && firstBad < 0) firstBad = 8 * t + __builtin_ctz(bad);
+        largest = _mm512_max_pd(a, largest);
+    }
+    [[gnu::target("avx2,avx512f")]] void finish(DiffusionMeasures& m) const {
+        double lanes[8];
+        _mm512_storeu_pd(lanes, change);
+        m.largestChange = 0.0;
+        for (const double l : lanes) m.largestChange = std::max(m.largestChange, l);
+        _mm512_storeu_pd(lanes, largest);
+        m.theta = GuardSums{};
+        for (const double l : lanes) m.theta.maxAbsTheta = std::max(m.theta.maxAbsTheta, l);
+        m.theta.firstBad = firstBad;
+    }
+};
+
+/// A tile by its rows, as diffuseParticle's loop over each lane's slots: each row's partners one
+/// load where they are a run, else a gather, its rates by rowRates.
+[[gnu::target("avx2,avx512f")]] inline __m512d rowsTileAvx512(const DiffusionTiles& d,
+                                                              const double* theta, __m512d own,
+                                                              __m512d step, int t) {
+    const int* __restrict run = d.rowRun.data();
+    __m512d flux = _mm512_setzero_pd();
+    for (int row = d.tileBegin[t] / 8; row < d.tileBegin[t + 1] / 8; ++row) {
+        const __m512d other =
+            run[row] >= 0 ? _mm512_loadu_pd(theta + run[row])
+                          : _mm512_i32gather_pd(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(
+                                                    d.partner.data() + 8 * row)),
+                                                theta, 8);
+        const __m512d term = _mm512_mul_pd(rowRates(d, row), _mm512_sub_pd(other, own));
+        flux = _mm512_mask_add_pd(flux, __mmask8(d.livingRows[row]), flux, term);
+    }
+    return _mm512_add_pd(own, _mm512_mul_pd(step, flux));
+}
+
+template <bool kMeasure>
 [[gnu::target("avx2,avx512f")]] void diffuseTilesAvx512(const DiffusionTiles& d,
                                                         const double* theta, double* next,
                                                         double dt, int firstTile, int lastTile,
-                                                        bool around) {
-    const int* __restrict begin = d.tileBegin.data();
-    const int* __restrict partner = d.partner.data();
-    const int* __restrict run = d.rowRun.data();
-    const std::uint8_t* __restrict living = d.livingRows.data();
+                                                        bool around, DiffusionMeasures* measures) {
     const std::uint8_t* __restrict plain = d.plainTile.data();
     const __m512d step = _mm512_set1_pd(dt);
     const bool stream = around && (std::uintptr_t(next) & 63) == 0;
+    MeasuresAvx512 taken;
     for (int t = firstTile; t < lastTile; ++t) {
+        const __m512d own = _mm512_loadu_pd(theta + 8 * t);
+        __m512d after;
         // Six rows are the hexagonal sheets' (every shipped scene's), eight the square's, twelve
         // a square sheet's of horizon 2.2. Only eight had a path of their own here before; the
-        // others went by the loop below, testing each row's run and class (crack_path_sources on
-        // its hexagonal lattice at 10^4, alternate spans: linear 6.51 / 6.51 -> 6.33 / 6.34 ns
-        // per particle-step, elastoplastic 8.43 / 8.27 -> 8.09 / 8.22, the same bits).
+        // others went by rows, testing each row's run and class (crack_path_sources on its
+        // hexagonal lattice at 10^4, alternate spans: linear 6.51 / 6.51 -> 6.33 / 6.34 ns per
+        // particle-step, elastoplastic 8.43 / 8.27 -> 8.09 / 8.22, the same bits).
         switch (plain[t]) {
             case 6:
-                diffusePlainTileAvx512<6>(d, theta, next, step, t, stream);
-                continue;
+                after = plainTileAvx512<6>(d, theta, own, step, t);
+                break;
             case 8:
-                diffusePlainTileAvx512<8>(d, theta, next, step, t, stream);
-                continue;
+                after = plainTileAvx512<8>(d, theta, own, step, t);
+                break;
             case 12:
-                diffusePlainTileAvx512<12>(d, theta, next, step, t, stream);
-                continue;
+                after = plainTileAvx512<12>(d, theta, own, step, t);
+                break;
             case 0:
+                after = rowsTileAvx512(d, theta, own, step, t);
                 break;
             default:
-                diffusePlainTileAvx512<0>(d, theta, next, step, t, stream, plain[t]);
-                continue;
+                after = plainTileAvx512<0>(d, theta, own, step, t, plain[t]);
+                break;
         }
-        const __m512d own = _mm512_loadu_pd(theta + 8 * t);
-        __m512d flux = _mm512_setzero_pd();
-        for (int row = begin[t] / 8; row < begin[t + 1] / 8; ++row) {
-            const __m512d other =
-                run[row] >= 0
-                    ? _mm512_loadu_pd(theta + run[row])
-                    : _mm512_i32gather_pd(
-                          _mm256_loadu_si256(reinterpret_cast<const __m256i*>(partner + 8 * row)),
-                          theta, 8);
-            const __m512d term = _mm512_mul_pd(rowRates(d, row), _mm512_sub_pd(other, own));
-            flux = _mm512_mask_add_pd(flux, __mmask8(living[row]), flux, term);
-        }
-        _mm512_storeu_pd(next + 8 * t, _mm512_add_pd(own, _mm512_mul_pd(step, flux)));
+        if (stream)
+            _mm512_stream_pd(next + 8 * t, after);
+        else
+            _mm512_storeu_pd(next + 8 * t, after);
+        if constexpr (kMeasure) taken.add(own, after, t);
     }
     if (stream) _mm_sfence();
+    if constexpr (kMeasure) taken.finish(*measures);
 }
 
 /// Whether the kRows (6, 8 or 12) bytes from `rows` are all 0xff: read as whole words each
@@ -437,15 +476,29 @@ template <int kRows>
 // read 8 bytes a particle for nothing (crack_path_sources at 10^7 particles, linear, alternate
 // spans of one run: 10.54 -> 10.50 and 10.84 -> 10.69 ns per particle-step).
 void diffuseTiles(const DiffusionTiles& tiles, const double* theta, double* next, double dt,
-                  int firstTile, int lastTile, std::optional<bool> around) {
+                  int firstTile, int lastTile, std::optional<bool> around,
+                  DiffusionMeasures* measures) {
 #if defined(__x86_64__)
-    if (simdWidth() == 8)
-        return diffuseTilesAvx512(
-            tiles, theta, next, dt, firstTile, lastTile,
-            around.value_or(streamsForces(8LL * (std::ssize(tiles.tileBegin) - 1))));
-    if (simdWidth() == 4) return diffuseTilesAvx2(tiles, theta, next, dt, firstTile, lastTile);
+    if (simdWidth() == 8) {
+        const bool streams =
+            around.value_or(streamsForces(8LL * (std::ssize(tiles.tileBegin) - 1)));
+        if (measures)
+            return diffuseTilesAvx512<true>(tiles, theta, next, dt, firstTile, lastTile, streams,
+                                            measures);
+        return diffuseTilesAvx512<false>(tiles, theta, next, dt, firstTile, lastTile, streams,
+                                         nullptr);
+    }
+    if (simdWidth() == 4) {
+        diffuseTilesAvx2(tiles, theta, next, dt, firstTile, lastTile);
+    } else
 #endif
-    for (int t = firstTile; t < lastTile; ++t) diffuseTile(tiles, theta, next, dt, t);
+    {
+        for (int t = firstTile; t < lastTile; ++t) diffuseTile(tiles, theta, next, dt, t);
+    }
+    if (!measures) return;
+    const int begin = 8 * firstTile, count = 8 * std::max(0, lastTile - firstTile);
+    measures->largestChange = largestChange(theta + begin, next + begin, std::size_t(count));
+    measures->theta = guardThetaSums(next, begin, begin + count);
 }
 
 }  // namespace rend::sim

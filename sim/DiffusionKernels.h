@@ -11,6 +11,7 @@
 
 #include "sim/Bonds.h"
 #include "sim/DamageState.h"
+#include "sim/StepKernels.h"
 
 namespace rend::sim {
 
@@ -62,11 +63,21 @@ private:
 void diffuseParticle(const DiffusionTiles& tiles, const double* theta, double* next, double dt,
                      int i);
 
+/// What diffuseTiles() may measure of the values it writes, as the functions named below would
+/// over the same particles (the same values).
+struct DiffusionMeasures {
+    double largestChange = 0.0;  ///< sim/PairKernels.h's largestChange(theta, next)
+    GuardSums theta;             ///< sim/StepKernels.h's guardThetaSums(next)
+};
+
 /// next[i] = theta[i] + dt sum over living bonds of rate (theta_j - theta_i), for the particles
 /// of tiles [firstTile, lastTile) (all eight of each). With `around`, the eight-lane sums of
 /// the plain tiles store around the caches where next lies on 64-byte lines (the same values);
 /// by default, where the sheet is larger than the caches (sim/PairSums.h's streamsForces()).
+/// With `measures`, their measures of those particles: eight lanes wide from the sums'
+/// registers, else by reading next back.
 void diffuseTiles(const DiffusionTiles& tiles, const double* theta, double* next, double dt,
-                  int firstTile, int lastTile, std::optional<bool> around = std::nullopt);
+                  int firstTile, int lastTile, std::optional<bool> around = std::nullopt,
+                  DiffusionMeasures* measures = nullptr);
 
 }  // namespace rend::sim

@@ -217,7 +217,9 @@ private:
     void kick(double h, double tNext);
     void updateVelocity(int i, double h, double tNext, const Eigen::Vector3d& gravity,
                         double damping);
-    void checkFinite();  ///< the blow-up guard, after every step
+    /// The blow-up guard, after every step; `thetaSums`: theta's half of its sample, where the
+    /// diffusion took it as it wrote theta this step (BlowUpGuard::State::thetaSums).
+    void checkFinite(const GuardSums* thetaSums = nullptr);
     /// Notches: breaks the bonds they cross and has the solver cut the same edges.
     void setUpNotches(const MembraneParams& params);
     ParticleLevelSet makeLevelSet() const;

@@ -8,12 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <tuple>
 #include <vector>
 
 #include "sim/DamageState.h"
 #include "sim/Diffusion.h"
+#include "sim/PairKernels.h"
 #include "sim/Random.h"
+#include "sim/StepKernels.h"
 
 using namespace rend::sim;
 
@@ -180,12 +183,21 @@ TEST_P(DiffusionTilesPlain, SumAsTheLoopDoes) {
     const std::vector<double> expected = naiveStep(bonds, rate, alive, theta, dt);
     // Stored through the caches and around them (as past the caches: the same values), into
     // 64-byte lines (a vector's heap block need not start on one).
+    // Their measures (the largest change, the guard's theta sums) are those of the values left.
     for (const bool around : {false, true}) {
         std::vector<double> buffer(n + 8, -1.0);
         double* next = buffer.data() + (8 - (std::uintptr_t(buffer.data()) / 8) % 8) % 8;
-        diffuseTiles(tiles, theta.data(), next, dt, 0, whole, around);
+        DiffusionMeasures measures;
+        measures.largestChange = -1.0, measures.theta.firstBad = 7;
+        diffuseTiles(tiles, theta.data(), next, dt, 0, whole, around, &measures);
         for (int i = kTile * whole; i < n; ++i) diffuseParticle(tiles, theta.data(), next, dt, i);
         EXPECT_EQ(std::memcmp(next, expected.data(), n * sizeof(double)), 0) << around;
+        const std::size_t tiled = std::size_t(kTile) * whole;
+        EXPECT_EQ(measures.largestChange, largestChange(theta.data(), expected.data(), tiled));
+        const GuardSums sums = guardThetaSums(expected.data(), 0, int(tiled));
+        EXPECT_EQ(measures.theta.maxAbsTheta, sums.maxAbsTheta);
+        EXPECT_GT(sums.maxAbsTheta, 0.0);
+        EXPECT_EQ(measures.theta.firstBad, -1);
     }
     int plain = 0, plainWithDead = 0;
     for (int t = 0; t < whole; ++t) {
@@ -265,6 +277,68 @@ TEST(DiffusionTiles, TheLastChangeBoundsEveryParticlesChange) {
     for (int i = 0; i < n; ++i) largest = std::max(largest, std::fabs(theta[i] - before[i]));
     EXPECT_GT(largest, 40.0);
     EXPECT_GE(held.lastChange(), largest);
+}
+
+// The guard's half of its sums that reads theta (sim/StepKernels.h's guardThetaSums: the largest
+// |theta|, the lowest index not finite), taken by the diffusion as it writes each chunk of 64
+// tiles, are those of the theta it leaves: with spots burning on particles of chunks summed
+// before (the largest |theta| theirs), an edge held (at one sub-step and at three), the few
+// particles past the whole tiles, and a NaN spreading from one particle.
+TEST(DiffusionTiles, TheGuardsSumsAreThoseOfTheThetaLeft) {
+    Sheet sheet;
+    sheet.params.sheet.size = {1.01, 0.4};  // 4,141 hexagonal particles: eight chunks and a tail
+    sheet.lattice = generateLattice(sheet.params.sheet);
+    sheet.bonds = buildBondFamilies(sheet.lattice.positions, 2.5 * sheet.params.sheet.dx);
+    sheet.volumes.assign(sheet.lattice.positions.size(),
+                         sheet.lattice.particleArea * sheet.params.sheet.thickness);
+    const int n = sheet.bonds.particleCount();
+    ASSERT_GT(n, 8 * 512 + 8);
+    ASSERT_NE(n % 8, 0);
+    sheet.params.diffusion.spots.push_back({{0.3, 0.1}, 0.03, 4e4});
+    sheet.params.diffusion.spots.push_back({{-0.2, 0.0}, 0.03, -3e4});
+    DamageState damage(sheet.bonds, sheet.lattice.triangles);
+    const auto expectSums = [&](const Diffusion& d, const std::vector<double>& theta,
+                                const char* what) {
+        const GuardSums expected = guardThetaSums(theta.data(), 0, n);
+        ASSERT_NE(d.thetaSums(), nullptr) << what;
+        EXPECT_EQ(d.thetaSums()->maxAbsTheta, expected.maxAbsTheta) << what;
+        EXPECT_EQ(d.thetaSums()->firstBad, expected.firstBad) << what;
+    };
+    Diffusion spots(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    EXPECT_EQ(spots.thetaSums(), nullptr) << "before the first advance";
+    std::vector<double> theta(n);
+    for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(4, i) - 0.5;
+    for (const double steps : {0.5, 2.5}) {
+        spots.advance(theta, damage, 0.0, steps * spots.stableTimeStep());
+        expectSums(spots, theta, "spots");
+        const double largest = *std::max_element(theta.begin(), theta.end());
+        EXPECT_EQ(spots.thetaSums()->maxAbsTheta, largest) << "a spot's particle";
+    }
+    theta[n - 1] = -1e6;  // past the whole tiles
+    spots.advance(theta, damage, 0.0, 0.5 * spots.stableTimeStep());
+    expectSums(spots, theta, "the last particle");
+    EXPECT_GT(spots.thetaSums()->maxAbsTheta, 5e5);
+    sheet.params.diffusion.edges.push_back({});  // the left edge's strip
+    sheet.params.diffusion.edges.back().region.max.x() = -0.45;
+    sheet.params.diffusion.edges.back().value = -5000.0;
+    Diffusion held(sheet.params, sheet.lattice.positions, sheet.bonds, sheet.volumes);
+    for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(4, i) - 0.5;
+    for (const double steps : {0.5, 2.5}) {
+        held.advance(theta, damage, 0.0, steps * held.stableTimeStep());
+        expectSums(held, theta, "held");
+        EXPECT_EQ(held.thetaSums()->maxAbsTheta, 5000.0) << "the held particles'";
+    }
+    // A NaN in the third chunk, which no spot touches: it spreads to its partners, the lowest
+    // of them inside a tile (not its first lane).
+    for (int i = 0; i < n; ++i) theta[i] = uniformFromHash(4, i) - 0.5;
+    const int bad = 2 * 512 + 77;
+    theta[bad] = std::numeric_limits<double>::quiet_NaN();
+    spots.advance(theta, damage, 0.0, 0.5 * spots.stableTimeStep());
+    expectSums(spots, theta, "a NaN");
+    const int firstBad = spots.thetaSums()->firstBad;
+    EXPECT_GE(firstBad, 512);
+    EXPECT_LT(firstBad, bad);
+    EXPECT_NE(firstBad % 8, 0);
 }
 
 }  // namespace

@@ -184,8 +184,9 @@ bool sameBits(const BlowUpGuard::Sample& a, const BlowUpGuard::Sample& b) {
 }
 
 // The motion the integrator samples block by block as it moves them (Membrane::kickAndDrift)
-// gives the sample check() takes in one pass, to the bit, with theta's part added at the check:
-// a NaN theta is still found. Changed velocities after it are not seen once it is forgotten.
+// gives the sample check() takes in one pass, to the bit, with theta's part added at the check
+// or handed over by the diffusion: a NaN theta is still found. Changed velocities after it are not
+// seen once it is forgotten.
 TEST(BlowUpGuard, TheMotionSampledAsItMovesIsTheCheckSample) {
     MembraneParams p = pulledSheet();
     p.sheet.size = {2.0, 2.0};  // several blocks
@@ -210,6 +211,15 @@ TEST(BlowUpGuard, TheMotionSampledAsItMovesIsTheCheckSample) {
         guard.sampleMotion(state, b);
     guard.endMotion();
     EXPECT_TRUE(sameBits(guard.sample(state), once));
+    // theta's half handed over, as the diffusion takes it while it writes theta
+    // (Diffusion::thetaSums): theta is not read for it, and the sample is the same.
+    const GuardSums thetaSums = guardThetaSums(theta.data(), 0, n);
+    BlowUpGuard::State handed = state;
+    handed.thetaSums = &thetaSums;
+    EXPECT_TRUE(sameBits(guard.sample(handed), once));
+    std::vector<double> unread(n, 0.0);  // what sample() would see if it read theta
+    handed.theta = unread;
+    EXPECT_TRUE(sameBits(guard.sample(handed), once));
     v[7] *= 100.0;  // moved after the sampling: a stale sample unless forgotten
     const BlowUpGuard::Sample moved = guard.sample(state);
     EXPECT_TRUE(sameBits(moved, once));

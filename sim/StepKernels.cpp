@@ -627,6 +627,10 @@ GuardSums guardAvx512(const GuardInput& g, int begin, int end) {
                : guardOctetsAvx512<false, false>(g, begin, end);
 }
 
+/// How far ahead the eight-lane kick asks for the velocities (an address, not a pointer: past
+/// the array's end a prefetch does nothing).
+constexpr int kVelocitiesAhead = 256;
+
 // The kick and drift of a block and the guard's sums of it in one loop, at eight lanes
 // (kickGuardQuadsAvx2's): each octet's new velocities split into lanes from registers.
 template <bool kOne, bool kFloor, bool kGravity>
@@ -637,6 +641,12 @@ template <bool kOne, bool kFloor, bool kGravity>
     GuardOctetsAvx512<kOne, kGravity> chains(g, begin);
     int i = begin;
     for (; i + 8 <= end; i += 8) {
+        // The velocities kVelocitiesAhead particles on, asked for now (sim/PairKernelSimd.inc's
+        // prefetchPositions: the force pass leaves them to the kick).
+        const std::uintptr_t ahead =
+            std::uintptr_t(kick.k.v) + 24 * (std::size_t(i) + kVelocitiesAhead);
+        for (int line = 0; line < 3; ++line)
+            __builtin_prefetch(reinterpret_cast<const void*>(ahead + 64 * line), 1);
         __m512d vel[3], vx, vy, vz;
         if (allFree(kick.k.constraint + i, 8)) {
             kick.template octet<false>(i, vel);
